@@ -1,0 +1,83 @@
+// The core's public entry point: mesh a PLC with SVRC (thesis ch. 3).
+// No gRPC, no protobuf: the service and the CLI both call MeshPlc.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/mesh/tet_mesh.h"
+#include "core/plc/plc.h"
+
+namespace svrc::core {
+
+// Mesh parameters. Names match the API (proto) and the CLI flags (`-` for `_`).
+struct MeshParams {
+  // Radius-edge bound for tets not touching a crease [tau/2]. TetGen -q2.
+  double radius_edge = 2.0;
+  // Warp radius factor [theta] (thesis §3.1.1).
+  double theta = 0.9;
+  // Largest representation angle on the collar surface, degrees [sigma].
+  double max_rep_angle = 30.0;
+  // Global max tet volume in input units³; <= 0: none.
+  double max_volume = 0.0;
+  // Sliver removal target in degrees (thesis §6.2.1); <= 0: off.
+  double min_dihedral = 0.0;
+  // Return the whole bounding-domain mesh instead of the PLC's regions.
+  bool keep_bounding_box = false;
+  // Hard cap on output vertices; 0: derived from the input (no-progress guard).
+  uint64_t max_vertices = 0;
+};
+
+// A snapshot of progress, reported from the meshing thread.
+struct Progress {
+  std::string phase;                 // "read", "validate", "refine", "stitch", ...
+  uint64_t vertices = 0;             // vertices in the output mesh so far
+  uint64_t queue_size = 0;           // pending work events
+  double largest_work_radius = 0;    // radius of the largest pending gap ball
+  double target_radius = 0;          // radius the refinement is heading for (0: n/a)
+  double elapsed_seconds = 0;
+};
+using ProgressCallback = std::function<void(const Progress&)>;
+
+// Cooperative cancellation: the mesher polls IsCancelled() every few hundred
+// insertions and then returns CANCELLED (or DEADLINE_EXCEEDED past the deadline).
+class CancelToken {
+ public:
+  CancelToken() = default;
+  explicit CancelToken(std::chrono::steady_clock::time_point deadline)
+      : deadline_ns_(deadline.time_since_epoch().count()) {}
+
+  void Cancel() { cancelled_.store(true, std::memory_order_relaxed); }
+  bool IsCancelled() const { return cancelled_.load(std::memory_order_relaxed); }
+  bool DeadlinePassed() const {
+    const int64_t d = deadline_ns_.load(std::memory_order_relaxed);
+    return d != 0 && std::chrono::steady_clock::now().time_since_epoch().count() >= d;
+  }
+  void SetDeadline(std::chrono::steady_clock::time_point deadline) {
+    deadline_ns_.store(deadline.time_since_epoch().count(), std::memory_order_relaxed);
+  }
+  // OK, CANCELLED or DEADLINE_EXCEEDED.
+  absl::Status Check() const;
+
+ private:
+  std::atomic<bool> cancelled_{false};
+  std::atomic<int64_t> deadline_ns_{0};
+};
+
+// Meshes `plc`. A PLC without segments and facets is a point set: the result
+// is its Delaunay tetrahedralization (what `tetgen` does without -p). `progress`
+// and `cancel` may be null. Errors: INVALID_ARGUMENT (broken input, with the
+// offending ids), UNIMPLEMENTED (a feature the core does not do yet — never a
+// wrong mesh), RESOURCE_EXHAUSTED (vertex budget), CANCELLED, DEADLINE_EXCEEDED.
+absl::StatusOr<mesh::TetMesh> MeshPlc(const plc::Plc& plc, const MeshParams& params,
+                                      const ProgressCallback& progress = nullptr,
+                                      const CancelToken* cancel = nullptr);
+
+// "svrc <major>.<minor>.<patch>", for provenance in every result.
+std::string Version();
+
+}  // namespace svrc::core

@@ -1,0 +1,30 @@
+// Readers for the input formats users bring (DESIGN.md "Core pipeline" 1):
+// TetGen .poly/.smesh/.node, .off, .stl (ASCII and binary), .obj, Medit .mesh
+// surfaces. A reader never crashes or hangs on malformed bytes: it returns
+// INVALID_ARGUMENT with file, line and reason.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "core/plc/plc.h"
+
+namespace svrc::plc {
+
+enum class InputFormat { kPoly, kSmesh, kNode, kOff, kStl, kObj, kMedit };
+
+// By extension (case-insensitive): .poly .smesh .node .off .stl .obj .mesh
+absl::StatusOr<InputFormat> FormatFromPath(std::string_view path);
+std::string_view FormatName(InputFormat format);
+
+// Parses `bytes` in `format`; `name` is used in messages and Plc::source_name.
+// Sets Plc::input_sha256. Surface formats merge exactly coplanar adjacent
+// triangles with equal markers into polygonal facets.
+absl::StatusOr<Plc> ReadPlcBytes(std::string_view bytes, InputFormat format,
+                                 std::string_view name);
+
+// Reads the file and dispatches on its extension.
+absl::StatusOr<Plc> ReadPlcFile(const std::string& path);
+
+}  // namespace svrc::plc

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Builds and runs every test. Assumes scripts/setup.sh ran (README's test
+# command does both). Stages, each timed:
+#   1. Release build of everything, all test suites (ctest)
+#   2. ASan+UBSan build of the core (no service), core-labelled suites
+# Env: SVRC_JOBS (default: nproc), SVRC_SKIP_SANITIZE=1 to skip stage 2.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$(pwd)
+JOBS=${SVRC_JOBS:-$(nproc)}
+export CCACHE_DIR=${CCACHE_DIR:-$ROOT/build/.ccache}
+export CTEST_OUTPUT_ON_FAILURE=1
+
+stage_start=0
+stage() { stage_start=$(date +%s); echo "=== [$(date -u +%H:%M:%S)] stage: $*"; }
+stage_end() { echo "=== stage done in $(( $(date +%s) - stage_start )) s: $*"; }
+t0=$(date +%s)
+
+stage "configure+build release"
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DSVRC_WERROR=ON >/dev/null
+cmake --build build/release -j "$JOBS"
+stage_end "build release"
+
+stage "tests (release)"
+ctest --test-dir build/release -j "$JOBS" --timeout 600
+stage_end "tests release"
+
+if [[ "${SVRC_SKIP_SANITIZE:-0}" != 1 ]]; then
+  stage "configure+build asan/ubsan (core)"
+  cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DSVRC_SANITIZE=address,undefined -DSVRC_BUILD_SERVICE=OFF -DSVRC_WERROR=ON >/dev/null
+  cmake --build build/asan -j "$JOBS"
+  stage_end "build asan"
+
+  stage "tests (asan/ubsan, label core)"
+  ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build/asan -L core -j "$JOBS" --timeout 900
+  stage_end "tests asan"
+fi
+echo "=== all stages done in $(( $(date +%s) - t0 )) s"

@@ -1,0 +1,20 @@
+// Helpers shared by the test suites: where the corpus is, reading files.
+// Tests that need ../shared FAIL (never skip) when it is missing.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace svrc::testing {
+
+// Absolute path of a corpus file, e.g. CorpusPath("a_convex/cube.poly").
+// Fails the current test (ADD_FAILURE) if the corpus folder is missing.
+std::string CorpusPath(const std::string& relative);
+
+// Whole file as bytes; fails the current test if it cannot be read.
+std::string ReadFileOrFail(const std::string& path);
+
+// A fresh empty directory under the test temp dir, unique per call.
+std::string MakeTempDir(const std::string& tag);
+
+}  // namespace svrc::testing
