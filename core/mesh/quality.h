@@ -1,0 +1,60 @@
+// Element quality of a TetMesh: radius-edge ratio (the SVRC bound τ/2 of thesis
+// §3, DESIGN.md "Quality"), the six dihedral angles and a normalized aspect
+// ratio, summarized as percentiles for tets touching a crease and the rest.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/mesh/tet_mesh.h"
+
+namespace svrc::mesh {
+
+struct TetQuality {
+  // Circumradius / shortest edge; √6/4 ≈ 0.612 for the regular tet,
+  // +inf for a degenerate (flat) tet.
+  double radius_edge = 0;
+  // Dihedral angles in degrees at edges (0,1) (0,2) (0,3) (1,2) (1,3) (2,3).
+  std::array<double, 6> dihedral_deg{};
+  double min_dihedral_deg = 0;
+  double max_dihedral_deg = 0;
+  // Longest edge / (2√6 · inradius): 1 for the regular tet, +inf when flat.
+  double aspect = 0;
+  double volume = 0;  // signed, det/6 in floating point (not exact)
+};
+
+TetQuality ComputeTetQuality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+// Order statistics of one metric (nearest-rank percentiles). All zero when
+// count == 0.
+struct Distribution {
+  size_t count = 0;
+  double min = 0, p1 = 0, p5 = 0, p50 = 0, p95 = 0, p99 = 0, max = 0;
+  // Sorts `values` (taken by value).
+  static Distribution Of(std::vector<double> values);
+};
+
+struct QualityGroup {
+  size_t num_tets = 0;
+  Distribution radius_edge;
+  Distribution dihedral_deg;  // all six angles of every tet of the group
+  Distribution min_dihedral_deg;  // per tet
+  Distribution aspect;
+};
+
+struct QualityReport {
+  QualityGroup crease;  // tets with at least one crease vertex
+  QualityGroup other;   // the rest (the radius-edge bound applies here)
+  QualityGroup all;
+};
+
+// `crease_vertex` is empty (no creases) or has one flag per mesh vertex.
+QualityReport ComputeQuality(const TetMesh& mesh,
+                             const std::vector<uint8_t>& crease_vertex = {});
+
+// Several lines of text for the CLI ("svrc mesh --stats"); ends with '\n'.
+std::string FormatQualityReport(const QualityReport& report);
+
+}  // namespace svrc::mesh
