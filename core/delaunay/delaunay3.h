@@ -1,0 +1,236 @@
+// Incremental 3D Delaunay triangulation (Bowyer–Watson) with ghost tets on the
+// convex hull, symbolic perturbation by caller-supplied global ids, and the
+// Voronoi queries SVRC needs on M_Ω (thesis §3.2, Definition 12, Lemma 3).
+//
+// Storage follows Geogram/HXT: flat struct-of-arrays with 32-bit indices.
+//   tet_v_[4t+i]  vertex i of tet t; kInfinite for the ghost vertex, which is
+//                 always at position 3 of a ghost tet.
+//   tet_n_[4t+f]  the neighbour across face f (the face opposite vertex f),
+//                 encoded 4t'+f' where f' is the same face seen from t'.
+// Every live tet is positively oriented: Orient3d(v0,v1,v2,v3) > 0. A ghost
+// tet (a,b,c,∞) has its finite face abc on the hull, oriented so that the
+// outside is on the positive side: Orient3d(a,b,c,q) > 0 for q beyond the hull.
+// Free tet slots form a free list; every slot carries a generation counter
+// that changes whenever the tet in it is destroyed, so (TetId, generation)
+// identifies one tet for good (SVRC's stale-event test).
+//
+// Degeneracies: orientation tests are exact (no perturbation: no flat tets,
+// ever); in-sphere tests are exact with simulation of simplicity by global id,
+// so cospherical and grid inputs give one reproducible triangulation that
+// does not depend on the insertion order. Global ids must be distinct.
+//
+// Not thread-safe, not even the const queries (they share scratch marks).
+#pragma once
+
+#include <compare>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "core/geometry/vec3.h"
+
+namespace svrc::delaunay {
+
+using geom::Vec3;
+
+// A 32-bit index with a type, so that vertex and tet ids do not mix.
+// Default-constructed ids are kNone.
+template <typename Tag>
+class TypedId {
+ public:
+  static constexpr uint32_t kNoneValue = 0xFFFFFFFFu;
+  constexpr TypedId() = default;
+  constexpr explicit TypedId(uint32_t value) : value_(value) {}
+  constexpr uint32_t value() const { return value_; }
+  constexpr bool valid() const { return value_ != kNoneValue; }
+  friend constexpr bool operator==(TypedId, TypedId) = default;
+  friend constexpr auto operator<=>(TypedId, TypedId) = default;
+
+ private:
+  uint32_t value_ = kNoneValue;
+};
+
+using VertexId = TypedId<struct VertexIdTag>;
+using TetId = TypedId<struct TetIdTag>;
+
+inline constexpr VertexId kNoneVertex{};
+inline constexpr TetId kNoneTet{};
+// The ghost vertex "at infinity" (never a valid index into vertex arrays).
+inline constexpr VertexId kInfiniteVertex{0xFFFFFFFEu};
+
+class Delaunay3 {
+ public:
+  enum class InsertOutcome : uint8_t {
+    kInserted,   // a new vertex; destroyed/created/cavity_vertices describe the change
+    kDuplicate,  // exactly equal to an existing vertex; nothing changed, `vertex` is that one
+    kPending,    // stored, but all vertices so far are coplanar: no tets yet
+  };
+
+  // What one insertion did. The spans point into the triangulation's scratch
+  // buffers and stay valid until the next mutating call.
+  struct InsertResult {
+    InsertOutcome outcome = InsertOutcome::kInserted;
+    VertexId vertex;
+    // Tets destroyed (their generation has been bumped) and created. Slots of
+    // destroyed tets are reused, so an id can appear in both lists: compare
+    // generations. Both lists include ghost tets.
+    std::span<const TetId> destroyed;
+    std::span<const TetId> created;
+    // Finite vertices on the cavity boundary (whose Voronoi cells changed),
+    // excluding `vertex`, each once, in a deterministic order.
+    std::span<const VertexId> cavity_vertices;
+  };
+
+  Delaunay3();
+  Delaunay3(const Delaunay3&) = default;
+  Delaunay3& operator=(const Delaunay3&) = default;
+  Delaunay3(Delaunay3&&) = default;
+  Delaunay3& operator=(Delaunay3&&) = default;
+
+  // Pre-allocates for about `num_vertices` vertices (tets ≈ 6.7 per vertex).
+  void Reserve(size_t num_vertices);
+
+  // Inserts `p` with SoS priority `global_id`. `hint` is any live tet near p
+  // (kNoneTet: the last created tet): if it conflicts with p the cavity grows
+  // from it directly — SVRC's ForceInsert passes a known conflicting tet and
+  // never locates globally — otherwise a deterministic visibility walk from it
+  // finds one. While fewer than four affinely independent points have been
+  // inserted, points are stored as kPending; the insertion that makes the set
+  // 3D builds the tetrahedralization of everything so far and reports all its
+  // tets as created. `p` must be finite.
+  InsertResult Insert(const Vec3& p, uint32_t global_id, TetId hint = kNoneTet);
+
+  // Locates p: returns a live tet whose closure contains p (a finite tet), or
+  // the ghost tet whose hull face sees p (p outside the hull). kNoneTet while
+  // there are no tets. Deterministic.
+  TetId Locate(const Vec3& p, TetId hint = kNoneTet) const;
+
+  // True iff p (with priority global_id) lies strictly inside the circumsphere
+  // of tet t after perturbation, i.e. inserting p would destroy t. For a ghost
+  // tet: p strictly beyond its hull face, or on the face's plane and inside its
+  // circumcircle (perturbed).
+  bool InConflict(TetId t, const Vec3& p, uint32_t global_id) const;
+
+  // --- Size and element access -------------------------------------------------
+
+  // Vertices ever inserted (including pending ones; duplicates get no id).
+  uint32_t NumVertices() const { return static_cast<uint32_t>(points_.size()); }
+  // Live tets, ghosts included / finite only.
+  uint32_t NumTets() const { return num_live_tets_; }
+  uint32_t NumFiniteTets() const { return num_live_tets_ - num_ghost_tets_; }
+  uint32_t NumGhostTets() const { return num_ghost_tets_; }
+  // One past the largest tet slot; iterate slots [0, TetCapacity()) and skip
+  // !IsAlive ones.
+  uint32_t TetCapacity() const { return static_cast<uint32_t>(tet_gen_.size()); }
+  // False before the first full-dimensional tet exists.
+  bool Is3d() const { return num_live_tets_ != 0; }
+
+  const Vec3& Point(VertexId v) const { return points_[v.value()]; }
+  uint32_t GlobalId(VertexId v) const { return global_ids_[v.value()]; }
+  // One live tet incident to v (kNoneTet while v is pending).
+  TetId VertexTet(VertexId v) const { return TetId(vertex_tet_[v.value()]); }
+
+  bool IsAlive(TetId t) const { return tet_v_[4 * t.value()] != kFreeSlot; }
+  bool IsGhost(TetId t) const { return tet_v_[4 * t.value() + 3] == kInfiniteVertex.value(); }
+  uint32_t Generation(TetId t) const { return tet_gen_[t.value()]; }
+  VertexId TetVertex(TetId t, int i) const { return VertexId(tet_v_[4 * t.value() + i]); }
+  // The tet across face f (opposite vertex f) and that face's index there.
+  TetId Neighbor(TetId t, int f) const { return TetId(tet_n_[4 * t.value() + f] >> 2); }
+  int NeighborFace(TetId t, int f) const { return static_cast<int>(tet_n_[4 * t.value() + f] & 3); }
+
+  // All live finite tets, in slot order.
+  std::vector<TetId> FiniteTets() const;
+
+  // --- Vertex queries (v must not be pending) ----------------------------------
+
+  // Tets incident to v, ghosts included, in a deterministic (BFS) order.
+  void Star(VertexId v, std::vector<TetId>* out) const;
+  // Finite vertices sharing an edge with v, in a deterministic order.
+  void Neighbors(VertexId v, std::vector<VertexId>* out) const;
+  // True iff v is on the convex hull (incident to a ghost tet).
+  bool IsHullVertex(VertexId v) const;
+  // Circumcentres of the finite tets incident to v (the corners of v's Voronoi
+  // cell; for a hull vertex the cell is unbounded and this lists the finite
+  // corners only).
+  void VoronoiCorners(VertexId v, std::vector<Vec3>* out) const;
+  // R_v: max distance from v to a corner of its (unclipped) Voronoi cell;
+  // +infinity for a hull vertex. If `farthest_corner` is set it receives the
+  // corner achieving R_v (ties: the first in Star order).
+  double OutRadius(VertexId v, Vec3* farthest_corner = nullptr) const;
+  // r_v: half the length of the shortest Delaunay edge at v (Lemma 3).
+  double InRadius(VertexId v) const;
+  // The vertex nearest to p (ties: smallest vertex id): walk + greedy descent
+  // on the Delaunay graph. kNoneVertex while !Is3d().
+  VertexId NearestVertex(const Vec3& p, TetId hint = kNoneTet) const;
+
+  // --- Tet constructions (finite tets) -----------------------------------------
+
+  // Circumcentre of finite tet t, computed relative to its vertex 0.
+  Vec3 Circumcenter(TetId t) const;
+  // Circumradius of finite tet t (distance from the circumcentre to vertex 0).
+  double Circumradius(TetId t) const;
+
+  // --- Checking ----------------------------------------------------------------
+
+  // Neighbour symmetry (face vertex sets match, orientations opposite), the
+  // ghost vertex at position 3, positive orientation of every finite tet, a
+  // convex hull, vertex→tet incidence, the free list, tet counts; with
+  // `check_empty_sphere`, every interior face and every hull edge is locally
+  // Delaunay under the perturbed in-sphere test (which makes it globally
+  // Delaunay). Linear time. INTERNAL with the offending ids on failure.
+  absl::Status Validate(bool check_empty_sphere) const;
+
+  // Predicate-level counters of this triangulation's work.
+  struct Stats {
+    uint64_t inserted = 0;
+    uint64_t duplicates = 0;
+    uint64_t walk_steps = 0;
+    uint64_t tets_created = 0;
+    uint64_t tets_destroyed = 0;
+  };
+  const Stats& stats() const { return stats_; }
+
+ private:
+  static constexpr uint32_t kFreeSlot = 0xFFFFFFFFu;
+  static constexpr uint32_t kInf = 0xFFFFFFFEu;
+
+  uint32_t NewTet();
+  void FreeTet(uint32_t t);
+  bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* duplicate) const;
+  uint32_t WalkRaw(const Vec3& p, uint32_t start, uint32_t* duplicate) const;
+  InsertResult InsertPending(const Vec3& p, uint32_t global_id);
+  void BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d);
+  InsertResult InsertVertex(uint32_t v, uint32_t start_conflict);
+  void StarRaw(uint32_t v, std::vector<uint32_t>* out) const;
+
+  // Vertices.
+  std::vector<Vec3> points_;
+  std::vector<uint32_t> global_ids_;
+  std::vector<uint32_t> vertex_tet_;
+  // Tets.
+  std::vector<uint32_t> tet_v_;
+  std::vector<uint32_t> tet_n_;
+  std::vector<uint32_t> tet_gen_;
+  mutable std::vector<uint32_t> tet_mark_;  // scratch stamps for searches
+  mutable uint32_t mark_stamp_ = 0;
+  uint32_t free_head_ = kFreeSlot;
+  uint32_t num_live_tets_ = 0;
+  uint32_t num_ghost_tets_ = 0;
+  uint32_t last_tet_ = kFreeSlot;
+  // While !Is3d(): the vertices inserted so far, in order.
+  std::vector<uint32_t> pending_;
+  // Insertion scratch (reported through InsertResult spans).
+  std::vector<TetId> destroyed_;
+  std::vector<TetId> created_;
+  std::vector<VertexId> cavity_vertices_;
+  std::vector<uint32_t> boundary_;  // 4t+f of outer faces of the cavity
+  std::vector<uint32_t> stack_;
+  std::vector<uint64_t> edge_keys_;
+  std::vector<uint32_t> edge_vals_;
+  mutable std::vector<uint32_t> vertex_mark_;
+  mutable uint32_t vertex_stamp_ = 0;
+  Stats stats_;
+};
+
+}  // namespace svrc::delaunay
