@@ -25,6 +25,9 @@ struct Facet {
   std::vector<Polygon> polygons;
   std::vector<Vec3> holes;
   int32_t marker = 0;
+  // Provenance for messages (may be empty): the input faces (0-based, file
+  // order) merged into this facet by a surface reader.
+  std::vector<uint32_t> input_faces;
 };
 
 // A free segment in the volume (a lone 2-vertex polygon in a .poly file).
@@ -50,6 +53,16 @@ struct Plc {
   std::vector<RegionSeed> regions;
   std::string source_name;              // file name or "<memory>", for messages
   std::string input_sha256;             // hex sha256 of the bytes read, "" if built in memory
+
+  // Provenance for messages, filled by the readers (all may be empty):
+  uint32_t index_base = 0;              // first vertex/facet number in the file (1 in .poly/.obj)
+  std::vector<uint32_t> vertex_lines;   // source line of each vertex (0 = unknown)
+  std::vector<uint32_t> facet_lines;    // source line of each facet (first input face)
+  // True for surface formats (.off .stl .obj .mesh): the facets are meant to
+  // bound a volume, so validation requires a closed surface (docs/plc.md).
+  bool is_surface = false;
+  uint32_t input_face_count = 0;        // faces in the file before coplanar merging
+  std::vector<std::string> marker_names;  // marker m -> STL solid / OBJ group name ("" if none)
 
   bool IsPointSet() const { return segments.empty() && facets.empty(); }
 };
