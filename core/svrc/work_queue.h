@@ -1,0 +1,150 @@
+// SVRC's work queues (thesis Figure 3.11, §3.2.1, §5.1.2, Lemmas 30–31): eleven
+// bucketed priority queues of gap-ball work events — Skinny₁₋₃, Encroached₁₋₂,
+// Unresolved₁₋₃, Collar₁₋₃ — scanned in the priority order of Dequeue.
+//
+// Inside one queue, events are bucketed by ⌊log₂ r⌋ (ilogb), the largest bucket is
+// served first, and a bucket is FIFO (push order) so runs are deterministic.
+// Events are keys (mesh, object, generation), not balls: whoever pops an event
+// decides whether it is stale (lazy deletion, as Triangle's bad-triangle queue
+// and Th. Figure 3.4 line 1 "no longer on the Voronoi skeleton").
+// DecreaseSize moves a queued event to a smaller bucket in O(1) and counts the
+// buckets it skips (Lemma 30's cost; Lemma 31 says it is O(1)).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "core/geometry/vec3.h"
+#include "core/svrc/ids.h"
+
+namespace svrc::refine {
+
+enum class EventType : uint8_t { kSkinny = 0, kEncroached = 1, kUnresolved = 2, kCollar = 3 };
+inline constexpr int kNumEventTypes = 4;
+const char* EventTypeName(EventType type);
+
+// One work event: a gap ball ⟨(center, radius), F⟩ to destroy in mesh `mesh`.
+// `dim` selects the queue: the mesh dimension for Skinny, Unresolved and Collar,
+// the dimension of the *ball's* feature (1 or 2) for Encroached (guide §3, 3.11).
+// `object` is the cell's vertex (Skinny/Unresolved: keyed by cell) or the ball id
+// (Encroached/Collar: keyed by ball); `generation` is that object's generation
+// when the event was made, so a popped event is stale iff it moved on.
+struct WorkEvent {
+  EventType type = EventType::kSkinny;
+  uint8_t dim = 3;
+  MeshId mesh;
+  uint32_t object = 0;
+  uint32_t generation = 0;
+  double radius = 0;
+  geom::Vec3 center;
+};
+
+// A handle to a queued event: slot + the slot's generation (a popped or removed
+// event's handle goes stale and every operation on it is a no-op).
+struct EventHandle {
+  EventId id;
+  uint32_t generation = 0;
+  bool valid() const { return id.valid(); }
+};
+
+class WorkQueues {
+ public:
+  // The eleven queues, indexed type*3 + (dim-1). Collar₁ exists (the thesis
+  // counts it) but Dequeue never scans it: 1D collar points are Unresolved₁
+  // events (Figure 3.11 scans "Collar 2 to 3"); Enqueue refuses it.
+  static constexpr int kNumQueues = 12;  // 4 types × dims 1..3; Encroached₃ unused
+  static int QueueIndex(EventType type, int dim) { return static_cast<int>(type) * 3 + (dim - 1); }
+
+  // Figure 3.11's Dequeue order: Skinny 1→3, Encroached 2→1, Unresolved 3→1,
+  // Collar 2→3.
+  static const std::array<int, 10>& PriorityOrder();
+
+  // Exponent range of buckets: ilogb of positive finite doubles is in
+  // [-1074, 1023]; radius 0 goes to the lowest bucket.
+  static constexpr int kMinExp = -1075;
+  static constexpr int kMaxExp = 1023;
+  static constexpr int kNumBuckets = kMaxExp - kMinExp + 1;
+  static int BucketOf(double radius);
+
+  WorkQueues();
+
+  // Push. Returns an invalid handle (and counts `rejected`) for an event that
+  // has no queue: Encroached with dim ∉ {1,2}, Collar₁, dim ∉ {1,2,3}, or a
+  // radius that is negative or not finite.
+  EventHandle Enqueue(const WorkEvent& event);
+
+  // Pops the highest-priority event (first non-empty queue in PriorityOrder,
+  // largest bucket, oldest in the bucket). nullopt when all are empty.
+  std::optional<WorkEvent> Dequeue();
+
+  // Pops events until one is live according to `is_live`; the others are
+  // dropped and counted as stale (per type). nullopt when all are empty.
+  std::optional<WorkEvent> DequeueLive(const std::function<bool(const WorkEvent&)>& is_live);
+
+  // Lemma 30: lowers the radius of a queued event (a larger radius is ignored:
+  // the thesis only ever shrinks events). Moves it to the back of its new bucket;
+  // `buckets_walked` grows by the number of buckets between old and new.
+  void DecreaseSize(EventHandle handle, double new_radius);
+
+  // Removes a queued event eagerly (lazy deletion is the norm; this is for
+  // callers that hold a handle anyway). No-op on a stale handle.
+  void Remove(EventHandle handle);
+
+  bool IsQueued(EventHandle handle) const;
+  const WorkEvent& Get(EventHandle handle) const;  // handle must be queued
+
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  size_t QueueSize(EventType type, int dim) const { return queue_size_[QueueIndex(type, dim)]; }
+  // Radius bucket of the largest pending event over all queues (for progress);
+  // 0 when empty.
+  double LargestPendingRadius() const;
+
+  struct Stats {
+    std::array<uint64_t, kNumEventTypes> pushed{};
+    std::array<uint64_t, kNumEventTypes> popped{};
+    std::array<uint64_t, kNumEventTypes> stale{};
+    uint64_t rejected = 0;
+    uint64_t decrease_size = 0;
+    // Empty buckets stepped over by Dequeue's cursor plus buckets skipped by
+    // DecreaseSize: Lemmas 30–31 say O(1) per operation.
+    uint64_t buckets_walked = 0;
+    uint64_t max_walk_one_op = 0;
+  };
+  const Stats& stats() const { return stats_; }
+
+  // Checks every list's links, sizes, cursors (no non-empty bucket above a
+  // cursor). For tests; linear in size + buckets.
+  bool Validate() const;
+
+ private:
+  static constexpr uint32_t kNil = 0xFFFFFFFFu;
+  struct Entry {
+    WorkEvent event;
+    uint32_t prev = kNil, next = kNil;
+    uint32_t generation = 0;
+    int16_t queue = -1;  // -1: free slot
+    int32_t bucket = 0;
+  };
+  struct Queue {
+    std::vector<uint32_t> head, tail;  // per bucket
+    int cursor = -1;                   // no non-empty bucket above it
+  };
+
+  void Link(uint32_t e, int queue, int bucket);
+  void Unlink(uint32_t e);
+  uint32_t PopFrom(int queue);
+  void Free(uint32_t e);
+
+  std::vector<Entry> entries_;
+  uint32_t free_head_ = kNil;
+  std::array<Queue, kNumQueues> queues_;
+  std::array<size_t, kNumQueues> queue_size_{};
+  size_t size_ = 0;
+  Stats stats_;
+};
+
+}  // namespace svrc::refine
