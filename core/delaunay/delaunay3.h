@@ -197,11 +197,13 @@ class Delaunay3 {
 
   uint32_t NewTet();
   void FreeTet(uint32_t t);
-  bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* duplicate) const;
-  uint32_t WalkRaw(const Vec3& p, uint32_t start, uint32_t* duplicate) const;
+  uint32_t FreshStamps(uint32_t n) const;
+  bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
+  uint32_t WalkRaw(const Vec3& p, uint32_t start, uint32_t* steps) const;
   InsertResult InsertPending(const Vec3& p, uint32_t global_id);
   void BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d);
-  InsertResult InsertVertex(uint32_t v, uint32_t start_conflict);
+  InsertResult InsertVertex(uint32_t v, uint32_t start_conflict, uint32_t sos_used);
+  void LinkAroundApex(uint32_t apex);
   void StarRaw(uint32_t v, std::vector<uint32_t>* out) const;
 
   // Vertices.
@@ -220,14 +222,20 @@ class Delaunay3 {
   uint32_t last_tet_ = kFreeSlot;
   // While !Is3d(): the vertices inserted so far, in order.
   std::vector<uint32_t> pending_;
+  std::vector<uint32_t> basis_;  // affinely independent pending vertices (<= 3)
   // Insertion scratch (reported through InsertResult spans).
   std::vector<TetId> destroyed_;
   std::vector<TetId> created_;
   std::vector<VertexId> cavity_vertices_;
   std::vector<uint32_t> boundary_;  // 4t+f of outer faces of the cavity
   std::vector<uint32_t> stack_;
-  std::vector<uint64_t> edge_keys_;
+  std::vector<uint32_t> new_v_;      // per boundary face: the new tet's vertices
+  std::vector<uint32_t> new_outer_;  // per boundary face: the outer neighbour 4t+f
+  std::vector<uint8_t> new_face_;    // per boundary face: its index in the new tet
+  std::vector<uint64_t> edge_keys_;  // stamped open-addressing table: edge → 4t+f
   std::vector<uint32_t> edge_vals_;
+  std::vector<uint32_t> edge_stamp_;
+  uint32_t edge_epoch_ = 0;
   mutable std::vector<uint32_t> vertex_mark_;
   mutable uint32_t vertex_stamp_ = 0;
   Stats stats_;

@@ -1,0 +1,759 @@
+// Incremental 3D Delaunay (Bowyer–Watson) — see delaunay3.h for the layout.
+//
+// Insertion of p: find one tet in conflict with p (the caller's hint if it
+// conflicts, else a visibility walk), grow the cavity (all tets whose
+// perturbed circumsphere strictly contains p) by a depth-first search over
+// faces, then replace it by the star of p: one new tet per cavity boundary
+// face, tet = the cavity tet's vertices with the one opposite that face
+// replaced by p (so orientation is inherited, and the ghost vertex stays at
+// position 3). New tets are glued to each other through the cavity-boundary
+// edge they share, found in a small stamped hash table.
+#include "core/delaunay/delaunay3.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_cat.h"
+#include "core/geometry/predicates.h"
+
+namespace svrc::delaunay {
+namespace {
+
+constexpr uint32_t kInf = kInfiniteVertex.value();
+
+// Face f of a tet consists of the vertices at kFaceVertices[f][0..2].
+constexpr int kFaceVertices[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+
+inline uint64_t EdgeKey(uint32_t a, uint32_t b) {
+  return a < b ? (static_cast<uint64_t>(a) << 32) | b : (static_cast<uint64_t>(b) << 32) | a;
+}
+inline uint32_t HashKey(uint64_t k) {
+  k *= 0x9E3779B97F4A7C15ull;
+  return static_cast<uint32_t>(k >> 40);
+}
+
+// Exactly collinear: every component of (b−a)×(c−a) is zero.
+bool Collinear(const Vec3& a, const Vec3& b, const Vec3& c) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (geom::Orient2dProjected(a, b, c, axis) != 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Delaunay3::Delaunay3() = default;
+
+void Delaunay3::Reserve(size_t num_vertices) {
+  points_.reserve(num_vertices);
+  global_ids_.reserve(num_vertices);
+  vertex_tet_.reserve(num_vertices);
+  const size_t tets = num_vertices * 7 + 64;
+  tet_v_.reserve(4 * tets);
+  tet_n_.reserve(4 * tets);
+  tet_gen_.reserve(tets);
+  tet_mark_.reserve(tets);
+}
+
+// ---------------------------------------------------------------------------
+// Tet slots.
+
+uint32_t Delaunay3::NewTet() {
+  uint32_t t;
+  if (free_head_ != kFreeSlot) {
+    t = free_head_;
+    free_head_ = tet_n_[4 * t];
+  } else {
+    t = static_cast<uint32_t>(tet_gen_.size());
+    tet_v_.resize(tet_v_.size() + 4);
+    tet_n_.resize(tet_n_.size() + 4);
+    tet_gen_.push_back(0);
+    tet_mark_.push_back(0);
+  }
+  ++num_live_tets_;
+  return t;
+}
+
+void Delaunay3::FreeTet(uint32_t t) {
+  if (tet_v_[4 * t + 3] == kInf) --num_ghost_tets_;
+  tet_v_[4 * t] = kFreeSlot;
+  tet_n_[4 * t] = free_head_;
+  free_head_ = t;
+  ++tet_gen_[t];
+  --num_live_tets_;
+}
+
+// Returns the first of n tet-mark values never used before (marks are never
+// cleared; a wrap-around clears them all once).
+uint32_t Delaunay3::FreshStamps(uint32_t n) const {
+  if (mark_stamp_ >= 0xFFFFFF00u) {
+    std::fill(tet_mark_.begin(), tet_mark_.end(), 0);
+    mark_stamp_ = 0;
+  }
+  const uint32_t first = mark_stamp_ + 1;
+  mark_stamp_ += n;
+  return first;
+}
+
+// ---------------------------------------------------------------------------
+// Predicates on tets.
+
+// Conflict of tet t with p. Sets *sos_used when the decision needed the
+// symbolic perturbation (an exactly cospherical / coplanar configuration).
+bool Delaunay3::ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const {
+  const uint32_t* v = &tet_v_[4 * t];
+  if (v[3] != kInf) {
+    const int s = geom::InSphere(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p);
+    if (s != 0) return s > 0;
+    *sos_used = 1;
+    return geom::internal::InSphereSoSTail(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p,
+                             global_ids_[v[0]], global_ids_[v[1]], global_ids_[v[2]],
+                             global_ids_[v[3]], gid) > 0;
+  }
+  // Ghost (a,b,c,∞): conflict iff p is strictly beyond the hull face, or on
+  // its plane and inside its circumcircle. The perturbed in-circle test equals
+  // the perturbed in-sphere test of the finite tet behind the face: the sphere
+  // meets the plane in the face's circumcircle, and under lifted perturbation
+  // the opposite vertex's term has coefficient Orient3d(a,b,c,p) = 0.
+  const int o = geom::Orient3d(points_[v[0]], points_[v[1]], points_[v[2]], p);
+  if (o != 0) return o > 0;
+  return ConflictRaw(tet_n_[4 * t + 3] >> 2, p, gid, sos_used);
+}
+
+bool Delaunay3::InConflict(TetId t, const Vec3& p, uint32_t global_id) const {
+  uint32_t sos = 0;
+  return ConflictRaw(t.value(), p, global_id, &sos);
+}
+
+// Visibility walk (Devillers–Pion–Teillaud "Walking in a triangulation"):
+// from a finite tet, cross a face whose outer side holds p until none does.
+// The face order rotates by a fixed xorshift sequence so the walk cannot
+// cycle in practice and is still deterministic. Returns a finite tet whose
+// closure contains p, or the ghost tet across the hull face p is beyond.
+uint32_t Delaunay3::WalkRaw(const Vec3& p, uint32_t t, uint32_t* steps) const {
+  if (tet_v_[4 * t + 3] == kInf) t = tet_n_[4 * t + 3] >> 2;
+  uint32_t rng = 0x2545F491u;
+  uint32_t from = 4;  // face we entered through (skip it)
+  for (;;) {
+    const uint32_t* v = &tet_v_[4 * t];
+    rng ^= rng << 13;
+    rng ^= rng >> 17;
+    rng ^= rng << 5;
+    const uint32_t r = rng & 3;
+    bool moved = false;
+    for (uint32_t k = 0; k < 4; ++k) {
+      const uint32_t f = (r + k) & 3;
+      if (f == from) continue;
+      Vec3 q[4] = {points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]};
+      q[f] = p;
+      if (geom::Orient3d(q[0], q[1], q[2], q[3]) < 0) {
+        const uint32_t n = tet_n_[4 * t + f];
+        t = n >> 2;
+        from = n & 3;
+        ++*steps;
+        if (tet_v_[4 * t + 3] == kInf) return t;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) return t;
+  }
+}
+
+TetId Delaunay3::Locate(const Vec3& p, TetId hint) const {
+  if (!Is3d()) return kNoneTet;
+  uint32_t start = hint.valid() && hint.value() < TetCapacity() && IsAlive(hint) ? hint.value()
+                                                                                  : last_tet_;
+  uint32_t steps = 0;
+  return TetId(WalkRaw(p, start, &steps));
+}
+
+// ---------------------------------------------------------------------------
+// Insertion.
+
+Delaunay3::InsertResult Delaunay3::Insert(const Vec3& p, uint32_t global_id, TetId hint) {
+  destroyed_.clear();
+  created_.clear();
+  cavity_vertices_.clear();
+  if (!Is3d()) return InsertPending(p, global_id);
+
+  uint32_t start = kFreeSlot;
+  uint32_t sos = 0;  // the hint's conflict needed the perturbation
+  if (hint.valid() && hint.value() < TetCapacity() && IsAlive(hint) &&
+      ConflictRaw(hint.value(), p, global_id, &sos)) {
+    start = hint.value();
+  } else {
+    uint32_t from = hint.valid() && hint.value() < TetCapacity() && IsAlive(hint) ? hint.value()
+                                                                                  : last_tet_;
+    uint32_t steps = 0;
+    start = WalkRaw(p, from, &steps);
+    stats_.walk_steps += steps;
+    // A finite tet whose closure holds p conflicts with p (p is strictly
+    // inside its circumsphere) unless p is one of its vertices.
+    if (tet_v_[4 * start + 3] != kInf) {
+      for (int i = 0; i < 4; ++i) {
+        if (points_[tet_v_[4 * start + i]] == p) {
+          ++stats_.duplicates;
+          InsertResult r;
+          r.outcome = InsertOutcome::kDuplicate;
+          r.vertex = VertexId(tet_v_[4 * start + i]);
+          return r;
+        }
+      }
+    }
+  }
+  const uint32_t v = static_cast<uint32_t>(points_.size());
+  points_.push_back(p);
+  global_ids_.push_back(global_id);
+  vertex_tet_.push_back(kFreeSlot);
+  InsertResult r = InsertVertex(v, start, sos);
+  if (r.outcome == InsertOutcome::kDuplicate) {
+    points_.pop_back();
+    global_ids_.pop_back();
+    vertex_tet_.pop_back();
+  }
+  return r;
+}
+
+// Bowyer–Watson step for the already stored vertex v, from a tet known to
+// conflict with it.
+Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint32_t sos) {
+  const Vec3 p = points_[v];
+  const uint32_t gid = global_ids_[v];
+  const uint32_t in_cavity = FreshStamps(2);
+  const uint32_t outside = in_cavity + 1;  // tested, not in conflict
+
+  destroyed_.clear();
+  boundary_.clear();
+  stack_.clear();
+  stack_.push_back(start);
+  tet_mark_[start] = in_cavity;
+  while (!stack_.empty()) {
+    const uint32_t t = stack_.back();
+    stack_.pop_back();
+    destroyed_.push_back(TetId(t));
+    for (uint32_t f = 0; f < 4; ++f) {
+      const uint32_t n = tet_n_[4 * t + f];
+      const uint32_t u = n >> 2;
+      const uint32_t m = tet_mark_[u];
+      if (m == in_cavity) continue;
+      if (m != outside) {
+        if (ConflictRaw(u, p, gid, &sos)) {
+          tet_mark_[u] = in_cavity;
+          stack_.push_back(u);
+          continue;
+        }
+        tet_mark_[u] = outside;
+      }
+      boundary_.push_back(4 * t + f);
+    }
+  }
+
+  // An exact duplicate only ever conflicts through the perturbation (p lies
+  // on, never strictly inside, the spheres of the tets around its twin).
+  if (sos) {
+    for (TetId dt : destroyed_) {
+      const uint32_t t = dt.value();
+      for (int i = 0; i < 4; ++i) {
+        const uint32_t w = tet_v_[4 * t + i];
+        if (w != kInf && w != v && points_[w] == p) {
+          ++stats_.duplicates;
+          // Nothing was modified; clear the cavity marks.
+          for (TetId d : destroyed_) tet_mark_[d.value()] = 0;
+          destroyed_.clear();
+          InsertResult r;
+          r.outcome = InsertOutcome::kDuplicate;
+          r.vertex = VertexId(w);
+          return r;
+        }
+      }
+    }
+  }
+
+  // New tets: record (vertices, outer neighbour) per boundary face before the
+  // cavity's slots are recycled.
+  const size_t nb = boundary_.size();
+  new_v_.resize(4 * nb);
+  new_outer_.resize(nb);
+  new_face_.resize(nb);
+  for (size_t k = 0; k < nb; ++k) {
+    const uint32_t b = boundary_[k];
+    const uint32_t t = b >> 2, f = b & 3;
+    for (int i = 0; i < 4; ++i) new_v_[4 * k + i] = tet_v_[4 * t + i];
+    new_v_[4 * k + f] = v;
+    new_outer_[k] = tet_n_[b];
+    new_face_[k] = static_cast<uint8_t>(f);
+  }
+  for (TetId dt : destroyed_) FreeTet(dt.value());
+
+  created_.clear();
+  for (size_t k = 0; k < nb; ++k) {
+    const uint32_t t = NewTet();
+    uint32_t* tv = &tet_v_[4 * t];
+    for (int i = 0; i < 4; ++i) tv[i] = new_v_[4 * k + i];
+    if (tv[3] == kInf) ++num_ghost_tets_;
+    const uint32_t f = new_face_[k];
+    const uint32_t o = new_outer_[k];
+    tet_n_[4 * t + f] = o;
+    tet_n_[o] = 4 * t + f;
+    tet_mark_[t] = 0;
+    created_.push_back(TetId(t));
+  }
+  LinkAroundApex(v);
+
+  // Vertex → tet and the cavity's vertices.
+  ++vertex_stamp_;
+  if (vertex_mark_.size() < points_.size()) vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
+  cavity_vertices_.clear();
+  for (TetId ct : created_) {
+    const uint32_t t = ct.value();
+    for (int i = 0; i < 4; ++i) {
+      const uint32_t w = tet_v_[4 * t + i];
+      if (w == kInf) continue;
+      vertex_tet_[w] = t;
+      if (w != v && vertex_mark_[w] != vertex_stamp_) {
+        vertex_mark_[w] = vertex_stamp_;
+        cavity_vertices_.push_back(VertexId(w));
+      }
+    }
+  }
+  last_tet_ = created_.back().value();
+  ++stats_.inserted;
+  stats_.tets_created += created_.size();
+  stats_.tets_destroyed += destroyed_.size();
+
+  InsertResult r;
+  r.outcome = InsertOutcome::kInserted;
+  r.vertex = VertexId(v);
+  r.destroyed = destroyed_;
+  r.created = created_;
+  r.cavity_vertices = cavity_vertices_;
+  return r;
+}
+
+// Glues the tets in created_ to each other. Every created tet contains the
+// apex vertex `apex`; its faces through the apex are matched through the edge
+// they share with the other face: the pair of vertices other than the apex
+// and the vertex opposite the face. Each such edge is shared by exactly two
+// created tets (the cavity boundary is a closed surface).
+void Delaunay3::LinkAroundApex(uint32_t apex) {
+  const size_t need = 4 * created_.size() * 3 / 2 + 16;
+  if (edge_keys_.size() < need) {
+    size_t sz = 64;
+    while (sz < 2 * need) sz *= 2;
+    edge_keys_.assign(sz, 0);
+    edge_vals_.assign(sz, 0);
+    edge_stamp_.assign(sz, 0);
+    edge_epoch_ = 0;
+  }
+  ++edge_epoch_;
+  if (edge_epoch_ == 0) {
+    std::fill(edge_stamp_.begin(), edge_stamp_.end(), 0);
+    edge_epoch_ = 1;
+  }
+  const uint32_t mask = static_cast<uint32_t>(edge_keys_.size() - 1);
+  for (TetId ct : created_) {
+    const uint32_t t = ct.value();
+    const uint32_t* tv = &tet_v_[4 * t];
+    int a = 0;
+    while (tv[a] != apex) ++a;
+    for (int i = 0; i < 4; ++i) {
+      if (i == a) continue;
+      // The face opposite i contains the apex and the edge {tv[j], tv[k]}.
+      uint32_t e[2];
+      int m = 0;
+      for (int j = 0; j < 4; ++j) {
+        if (j != i && j != a) e[m++] = tv[j];
+      }
+      const uint64_t key = EdgeKey(e[0], e[1]);
+      uint32_t h = HashKey(key) & mask;
+      for (;;) {
+        if (edge_stamp_[h] != edge_epoch_) {
+          edge_stamp_[h] = edge_epoch_;
+          edge_keys_[h] = key;
+          edge_vals_[h] = 4 * t + i;
+          break;
+        }
+        if (edge_keys_[h] == key) {
+          const uint32_t other = edge_vals_[h];
+          tet_n_[4 * t + i] = other;
+          tet_n_[other] = 4 * t + i;
+          break;
+        }
+        h = (h + 1) & mask;
+      }
+    }
+  }
+}
+
+// Before the first tetrahedron: keep points, track the affine hull of the
+// points so far through a basis (up to three of them), and build the first
+// tetrahedralization when a point leaves the basis's plane.
+Delaunay3::InsertResult Delaunay3::InsertPending(const Vec3& p, uint32_t global_id) {
+  InsertResult r;
+  for (uint32_t w : pending_) {
+    if (points_[w] == p) {
+      ++stats_.duplicates;
+      r.outcome = InsertOutcome::kDuplicate;
+      r.vertex = VertexId(w);
+      return r;
+    }
+  }
+  const uint32_t v = static_cast<uint32_t>(points_.size());
+  points_.push_back(p);
+  global_ids_.push_back(global_id);
+  vertex_tet_.push_back(kFreeSlot);
+  pending_.push_back(v);
+  r.vertex = VertexId(v);
+  r.outcome = InsertOutcome::kPending;
+  if (basis_.size() < 2) {
+    basis_.push_back(v);  // distinct from basis_[0]: not a duplicate
+    return r;
+  }
+  if (basis_.size() == 2) {
+    if (!Collinear(points_[basis_[0]], points_[basis_[1]], p)) basis_.push_back(v);
+    return r;
+  }
+  if (geom::Orient3d(points_[basis_[0]], points_[basis_[1]], points_[basis_[2]], p) == 0) {
+    return r;
+  }
+  // Full-dimensional: the first tet, then the other pending points in order.
+  BuildFirstTet(basis_[0], basis_[1], basis_[2], v);
+  std::vector<uint32_t> rest;
+  for (uint32_t w : pending_) {
+    if (w != basis_[0] && w != basis_[1] && w != basis_[2] && w != v) rest.push_back(w);
+  }
+  pending_.clear();
+  pending_.shrink_to_fit();
+  Stats before = stats_;
+  for (uint32_t w : rest) {
+    uint32_t steps = 0;
+    const uint32_t start = WalkRaw(points_[w], last_tet_, &steps);
+    // Pending points are pairwise distinct, so no duplicate can occur.
+    InsertVertex(w, start, 0);
+  }
+  stats_.inserted = before.inserted + 1 + rest.size();
+  destroyed_.clear();
+  created_.clear();
+  cavity_vertices_.clear();
+  for (uint32_t t = 0; t < TetCapacity(); ++t) {
+    if (IsAlive(TetId(t))) created_.push_back(TetId(t));
+  }
+  for (uint32_t w = 0; w < v; ++w) cavity_vertices_.push_back(VertexId(w));
+  r.outcome = InsertOutcome::kInserted;
+  r.created = created_;
+  r.cavity_vertices = cavity_vertices_;
+  return r;
+}
+
+void Delaunay3::BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+  if (geom::Orient3d(points_[a], points_[b], points_[c], points_[d]) < 0) std::swap(a, b);
+  const uint32_t t0 = NewTet();
+  const uint32_t tv[4] = {a, b, c, d};
+  for (int i = 0; i < 4; ++i) tet_v_[4 * t0 + i] = tv[i];
+  tet_mark_[t0] = 0;
+  created_.clear();
+  for (int f = 0; f < 4; ++f) {
+    // Replacing vertex f by ∞ gives a negatively oriented ghost; one
+    // transposition moving ∞ to position 3 fixes the orientation.
+    uint32_t g[4] = {a, b, c, d};
+    g[f] = kInf;
+    if (f != 3) std::swap(g[f], g[3]);
+    else std::swap(g[0], g[1]);
+    const uint32_t t = NewTet();
+    for (int i = 0; i < 4; ++i) tet_v_[4 * t + i] = g[i];
+    ++num_ghost_tets_;
+    tet_mark_[t] = 0;
+    tet_n_[4 * t + 3] = 4 * t0 + f;
+    tet_n_[4 * t0 + f] = 4 * t + 3;
+    created_.push_back(TetId(t));
+  }
+  LinkAroundApex(kInf);
+  for (int i = 0; i < 4; ++i) vertex_tet_[tv[i]] = t0;
+  last_tet_ = t0;
+}
+
+// ---------------------------------------------------------------------------
+// Queries.
+
+std::vector<TetId> Delaunay3::FiniteTets() const {
+  std::vector<TetId> out;
+  out.reserve(NumFiniteTets());
+  for (uint32_t t = 0; t < TetCapacity(); ++t) {
+    if (tet_v_[4 * t] != kFreeSlot && tet_v_[4 * t + 3] != kInf) out.push_back(TetId(t));
+  }
+  return out;
+}
+
+void Delaunay3::StarRaw(uint32_t v, std::vector<uint32_t>* out) const {
+  out->clear();
+  const uint32_t t0 = vertex_tet_[v];
+  if (t0 == kFreeSlot) return;
+  const uint32_t stamp = FreshStamps(1);
+  out->push_back(t0);
+  tet_mark_[t0] = stamp;
+  for (size_t k = 0; k < out->size(); ++k) {
+    const uint32_t t = (*out)[k];
+    for (int f = 0; f < 4; ++f) {
+      if (tet_v_[4 * t + f] == v) continue;  // the face opposite v does not contain v
+      const uint32_t u = tet_n_[4 * t + f] >> 2;
+      if (tet_mark_[u] != stamp) {
+        tet_mark_[u] = stamp;
+        out->push_back(u);
+      }
+    }
+  }
+}
+
+void Delaunay3::Star(VertexId v, std::vector<TetId>* out) const {
+  std::vector<uint32_t> raw;
+  StarRaw(v.value(), &raw);
+  out->clear();
+  out->reserve(raw.size());
+  for (uint32_t t : raw) out->push_back(TetId(t));
+}
+
+void Delaunay3::Neighbors(VertexId v, std::vector<VertexId>* out) const {
+  std::vector<uint32_t> star;
+  StarRaw(v.value(), &star);
+  out->clear();
+  ++vertex_stamp_;
+  if (vertex_mark_.size() < points_.size()) vertex_mark_.resize(points_.size() + 16, 0);
+  for (uint32_t t : star) {
+    for (int i = 0; i < 4; ++i) {
+      const uint32_t w = tet_v_[4 * t + i];
+      if (w == kInf || w == v.value() || vertex_mark_[w] == vertex_stamp_) continue;
+      vertex_mark_[w] = vertex_stamp_;
+      out->push_back(VertexId(w));
+    }
+  }
+}
+
+bool Delaunay3::IsHullVertex(VertexId v) const {
+  std::vector<uint32_t> star;
+  StarRaw(v.value(), &star);
+  for (uint32_t t : star) {
+    if (tet_v_[4 * t + 3] == kInf) return true;
+  }
+  return false;
+}
+
+void Delaunay3::VoronoiCorners(VertexId v, std::vector<Vec3>* out) const {
+  std::vector<uint32_t> star;
+  StarRaw(v.value(), &star);
+  out->clear();
+  for (uint32_t t : star) {
+    if (tet_v_[4 * t + 3] != kInf) out->push_back(Circumcenter(TetId(t)));
+  }
+}
+
+double Delaunay3::OutRadius(VertexId v, Vec3* farthest_corner) const {
+  std::vector<uint32_t> star;
+  StarRaw(v.value(), &star);
+  const Vec3& pv = points_[v.value()];
+  double best = -1;
+  Vec3 corner;
+  for (uint32_t t : star) {
+    if (tet_v_[4 * t + 3] == kInf) {
+      if (farthest_corner) *farthest_corner = Vec3(HUGE_VAL, HUGE_VAL, HUGE_VAL);
+      return std::numeric_limits<double>::infinity();
+    }
+    const Vec3 c = Circumcenter(TetId(t));
+    const double d = geom::Dist(c, pv);
+    if (d > best) {
+      best = d;
+      corner = c;
+    }
+  }
+  if (farthest_corner) *farthest_corner = corner;
+  return best;
+}
+
+double Delaunay3::InRadius(VertexId v) const {
+  std::vector<VertexId> nbrs;
+  Neighbors(v, &nbrs);
+  const Vec3& pv = points_[v.value()];
+  double best = std::numeric_limits<double>::infinity();
+  for (VertexId w : nbrs) best = std::min(best, geom::Dist2(points_[w.value()], pv));
+  return 0.5 * std::sqrt(best);
+}
+
+VertexId Delaunay3::NearestVertex(const Vec3& p, TetId hint) const {
+  if (!Is3d()) return kNoneVertex;
+  const uint32_t t = Locate(p, hint).value();
+  uint32_t best = kFreeSlot;
+  auto consider = [&](uint32_t w) {
+    if (w == best) return false;
+    if (best != kFreeSlot) {
+      // > 0: the current best is farther than w.
+      const int c = geom::CompareDistance(p, points_[best], points_[w]);
+      if (c < 0 || (c == 0 && best < w)) return false;
+    }
+    best = w;
+    return true;
+  };
+  for (int i = 0; i < 4; ++i) {
+    if (tet_v_[4 * t + i] != kInf) consider(tet_v_[4 * t + i]);
+  }
+  // Greedy descent: in a Delaunay graph, a vertex that is not nearest to p
+  // has a neighbour strictly nearer (the Delaunay graph contains the nearest
+  // neighbour's Voronoi adjacency along the segment to p).
+  std::vector<VertexId> nbrs;
+  for (;;) {
+    Neighbors(VertexId(best), &nbrs);
+    bool improved = false;
+    for (VertexId w : nbrs) improved |= consider(w.value());
+    if (!improved) return VertexId(best);
+  }
+}
+
+Vec3 Delaunay3::Circumcenter(TetId t) const {
+  const uint32_t* v = &tet_v_[4 * t.value()];
+  const Vec3 a = points_[v[0]];
+  const Vec3 b = points_[v[1]] - a, c = points_[v[2]] - a, d = points_[v[3]] - a;
+  // Relative to a: x = (|b|²(c×d) + |c|²(d×b) + |d|²(b×c)) / (2 b·(c×d)).
+  const Vec3 cd = geom::Cross(c, d), db = geom::Cross(d, b), bc = geom::Cross(b, c);
+  const double den = 2.0 * geom::Dot(b, cd);
+  const Vec3 num = geom::Norm2(b) * cd + geom::Norm2(c) * db + geom::Norm2(d) * bc;
+  return a + num / den;
+}
+
+double Delaunay3::Circumradius(TetId t) const {
+  return geom::Dist(Circumcenter(t), points_[tet_v_[4 * t.value()]]);
+}
+
+// ---------------------------------------------------------------------------
+// Validation.
+
+absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
+  const uint32_t cap = TetCapacity();
+  uint32_t live = 0, ghosts = 0;
+  for (uint32_t t = 0; t < cap; ++t) {
+    const uint32_t* v = &tet_v_[4 * t];
+    if (v[0] == kFreeSlot) continue;
+    ++live;
+    for (int i = 0; i < 4; ++i) {
+      if (v[i] == kInf) {
+        if (i != 3) return absl::InternalError(absl::StrCat("tet ", t, ": ghost vertex at position ", i));
+        continue;
+      }
+      if (v[i] >= points_.size()) return absl::InternalError(absl::StrCat("tet ", t, ": vertex id out of range"));
+      for (int j = 0; j < i; ++j) {
+        if (v[j] == v[i]) return absl::InternalError(absl::StrCat("tet ", t, ": repeated vertex ", v[i]));
+      }
+    }
+    const bool ghost = v[3] == kInf;
+    if (ghost) ++ghosts;
+    if (!ghost && geom::Orient3d(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]) <= 0) {
+      return absl::InternalError(absl::StrCat("tet ", t, " (", v[0], ",", v[1], ",", v[2], ",", v[3],
+                                              ") is not positively oriented"));
+    }
+    for (int f = 0; f < 4; ++f) {
+      const uint32_t n = tet_n_[4 * t + f];
+      const uint32_t u = n >> 2, g = n & 3;
+      if (u >= cap || tet_v_[4 * u] == kFreeSlot) {
+        return absl::InternalError(absl::StrCat("tet ", t, " face ", f, ": neighbour ", u, " is not alive"));
+      }
+      if (tet_n_[n] != 4 * t + f) {
+        return absl::InternalError(absl::StrCat("tet ", t, " face ", f, ": neighbour ", u, " face ", g,
+                                                " does not point back"));
+      }
+      // Same vertex set, opposite orientation: the even permutation taking
+      // the face of t to the face of u must reverse the cyclic order.
+      const int* fa = kFaceVertices[f];
+      const int* fb = kFaceVertices[g];
+      uint32_t A[3] = {v[fa[0]], v[fa[1]], v[fa[2]]};
+      uint32_t B[3] = {tet_v_[4 * u + fb[0]], tet_v_[4 * u + fb[1]], tet_v_[4 * u + fb[2]]};
+      // Orientation of a face listed by kFaceVertices[f] flips with the
+      // parity of f (faces 0 and 2 are listed negatively w.r.t. the outward
+      // normal, 1 and 3 positively), so normalise to outward order.
+      if ((f & 1) == 0) std::swap(A[0], A[1]);
+      if ((g & 1) == 0) std::swap(B[0], B[1]);
+      // Outward orders of the shared face in t and u must be reverses.
+      bool ok = false;
+      for (int s = 0; s < 3 && !ok; ++s) {
+        ok = A[0] == B[(s + 0) % 3] && A[1] == B[(s + 2) % 3] && A[2] == B[(s + 1) % 3];
+      }
+      if (!ok) {
+        return absl::InternalError(absl::StrCat("tet ", t, " face ", f, " and tet ", u, " face ", g,
+                                                ": faces do not match with opposite orientation"));
+      }
+      if (ghost && u == t) return absl::InternalError("self-neighbour");
+    }
+    if (tet_gen_.size() != cap || tet_n_.size() != 4 * size_t{cap}) return absl::InternalError("array sizes");
+  }
+  if (live != num_live_tets_ || ghosts != num_ghost_tets_) {
+    return absl::InternalError(absl::StrCat("tet counts: found ", live, " live / ", ghosts,
+                                            " ghost, recorded ", num_live_tets_, " / ", num_ghost_tets_));
+  }
+  uint32_t free_count = 0;
+  for (uint32_t t = free_head_; t != kFreeSlot; t = tet_n_[4 * t]) {
+    if (t >= cap || tet_v_[4 * t] != kFreeSlot || ++free_count > cap) {
+      return absl::InternalError("free list corrupt");
+    }
+  }
+  if (free_count + live != cap) return absl::InternalError("free list does not cover dead slots");
+  if (Is3d()) {
+    for (uint32_t w = 0; w < points_.size(); ++w) {
+      const uint32_t t = vertex_tet_[w];
+      if (t == kFreeSlot) continue;  // a rejected duplicate never gets here; pending only before 3D
+      if (t >= cap || tet_v_[4 * t] == kFreeSlot) {
+        return absl::InternalError(absl::StrCat("vertex ", w, ": incident tet ", t, " not alive"));
+      }
+      const uint32_t* v = &tet_v_[4 * t];
+      if (v[0] != w && v[1] != w && v[2] != w && v[3] != w) {
+        return absl::InternalError(absl::StrCat("vertex ", w, ": tet ", t, " does not contain it"));
+      }
+    }
+    for (uint32_t w = 0; w < points_.size(); ++w) {
+      if (vertex_tet_[w] == kFreeSlot) {
+        return absl::InternalError(absl::StrCat("vertex ", w, " is in no tet"));
+      }
+    }
+  }
+  // Convex hull: for ghost (a,b,c,∞), the finite vertex d of a neighbouring
+  // ghost must not be strictly beyond abc.
+  for (uint32_t t = 0; t < cap; ++t) {
+    const uint32_t* v = &tet_v_[4 * t];
+    if (v[0] == kFreeSlot || v[3] != kInf) continue;
+    for (int f = 0; f < 3; ++f) {
+      const uint32_t n = tet_n_[4 * t + f];
+      const uint32_t d = tet_v_[4 * (n >> 2) + (n & 3)];
+      if (d == kInf) return absl::InternalError("ghost neighbour opposite ∞");
+      const int o = geom::Orient3d(points_[v[0]], points_[v[1]], points_[v[2]], points_[d]);
+      if (o > 0) {
+        return absl::InternalError(absl::StrCat("hull not convex at ghost ", t, ": vertex ", d,
+                                                " beyond face (", v[0], ",", v[1], ",", v[2], ")"));
+      }
+      if (check_empty_sphere && o == 0) {
+        uint32_t sos = 0;
+        if (ConflictRaw(t, points_[d], global_ids_[d], &sos)) {
+          return absl::InternalError(absl::StrCat("hull face (", v[0], ",", v[1], ",", v[2],
+                                                  ") not Delaunay: coplanar vertex ", d, " in its circle"));
+        }
+      }
+    }
+  }
+  if (check_empty_sphere) {
+    for (uint32_t t = 0; t < cap; ++t) {
+      const uint32_t* v = &tet_v_[4 * t];
+      if (v[0] == kFreeSlot || v[3] == kInf) continue;
+      for (int f = 0; f < 4; ++f) {
+        const uint32_t n = tet_n_[4 * t + f];
+        const uint32_t u = n >> 2;
+        if (tet_v_[4 * u + 3] == kInf) continue;
+        const uint32_t d = tet_v_[4 * u + (n & 3)];
+        uint32_t sos = 0;
+        if (ConflictRaw(t, points_[d], global_ids_[d], &sos)) {
+          return absl::InternalError(absl::StrCat("face ", f, " of tet ", t, " (", v[0], ",", v[1], ",",
+                                                  v[2], ",", v[3], ") not locally Delaunay: vertex ",
+                                                  d, " inside"));
+        }
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace svrc::delaunay
