@@ -1,0 +1,83 @@
+// Protective balls (thesis §3.2.2). See balls.h.
+#include "core/svrc/balls.h"
+
+#include <cmath>
+
+namespace svrc::refine {
+
+using geom::Vec3;
+
+void DiametralBall(const Vec3& a, const Vec3& b, Vec3* center, double* radius) {
+  *center = 0.5 * (a + b);
+  *radius = 0.5 * geom::Dist(a, b);
+}
+
+void TriangleCircumball(const Vec3& a, const Vec3& b, const Vec3& c, Vec3* center, double* radius) {
+  // With u = b−a, w = c−a, n = u×w: the circumcentre is
+  //   a + (|u|²(w×n) + |w|²(n×u)) / (2|n|²)
+  // (the standard formula; relative to a so that translation does not cost
+  // precision). Degenerate triangles give a non-finite centre: callers only
+  // build balls of mesh triangles, which are non-degenerate.
+  const Vec3 u = b - a, w = c - a;
+  const Vec3 n = geom::Cross(u, w);
+  const Vec3 rel = (geom::Norm2(u) * geom::Cross(w, n) + geom::Norm2(w) * geom::Cross(n, u)) /
+                   (2.0 * geom::Norm2(n));
+  *center = a + rel;
+  *radius = geom::Norm(rel);
+}
+
+BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureId feature,
+                      MeshId mesh, Cd cd, int n, std::array<PointId, 3> verts) {
+  const BallId id(size());
+  center_.push_back(center);
+  radius_.push_back(radius);
+  kind_.push_back(kind);
+  feature_.push_back(feature);
+  mesh_.push_back(mesh);
+  cd_.push_back(cd);
+  num_verts_.push_back(static_cast<uint8_t>(n));
+  verts_.push_back(verts);
+  alive_.push_back(1);
+  generation_.push_back(0);
+  first_encroacher_.push_back(kNonePoint);
+  encroach_queued_.push_back(0);
+  ++num_alive_;
+  return id;
+}
+
+BallId BallStore::AddVertexBall(PointId p, const Vec3& center, FeatureId feature, MeshId mesh,
+                                Cd cd) {
+  return Add(BallKind::kConf, center, 0.0, feature, mesh, cd, 1, {p, kNonePoint, kNonePoint});
+}
+
+BallId BallStore::AddPieceBall(PointId a, PointId b, const Vec3& pa, const Vec3& pb,
+                               FeatureId feature, MeshId mesh) {
+  Vec3 c;
+  double r;
+  DiametralBall(pa, pb, &c, &r);
+  return Add(BallKind::kConf, c, r, feature, mesh, kCdSegment, 2, {a, b, kNonePoint});
+}
+
+BallId BallStore::AddTriangleBall(PointId a, PointId b, PointId c, const Vec3& center,
+                                  double radius, FeatureId feature, MeshId mesh) {
+  return Add(BallKind::kConf, center, radius, feature, mesh, kCdFacet, 3, {a, b, c});
+}
+
+void BallStore::Kill(BallId b) {
+  if (!alive_[b.value()]) return;
+  alive_[b.value()] = 0;
+  ++generation_[b.value()];
+  --num_alive_;
+}
+
+EncroachOutcome BallStore::RecordEncroacher(BallId b, PointId v, bool native) {
+  if (native) return EncroachOutcome::kEnqueue;
+  PointId& first = first_encroacher_[b.value()];
+  if (!first.valid()) {
+    first = v;
+    return EncroachOutcome::kPartial;
+  }
+  return first == v ? EncroachOutcome::kNothing : EncroachOutcome::kEnqueue;
+}
+
+}  // namespace svrc::refine
