@@ -27,4 +27,13 @@ absl::StatusOr<Plc> ReadPlcBytes(std::string_view bytes, InputFormat format,
 // Reads the file and dispatches on its extension.
 absl::StatusOr<Plc> ReadPlcFile(const std::string& path);
 
+struct ReadOptions {
+  // Surface formats: merge exactly coplanar edge-adjacent faces with equal
+  // markers into polygonal facets (the default; false keeps one facet per face).
+  bool merge_coplanar = true;
+};
+absl::StatusOr<Plc> ReadPlcBytes(std::string_view bytes, InputFormat format,
+                                 std::string_view name, const ReadOptions& options);
+absl::StatusOr<Plc> ReadPlcFile(const std::string& path, const ReadOptions& options);
+
 }  // namespace svrc::plc

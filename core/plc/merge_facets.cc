@@ -1,0 +1,274 @@
+// Surface soups to PLCs: exact vertex merging (STL) and merging of exactly
+// coplanar edge-adjacent faces with equal markers into polygonal facets
+// (guide §5 item 7: the STL cube must become six quadrilaterals, not twelve
+// triangles whose 45° corners would all be creases).
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <map>
+#include <numeric>
+#include <utility>
+
+#include "core/plc/exact.h"
+#include "core/plc/polygon2d.h"
+#include "core/plc/read_internal.h"
+
+namespace svrc::plc::internal {
+namespace {
+
+uint64_t Bits(double d) {
+  if (d == 0) d = 0;  // -0.0 and 0.0 are the same point
+  return std::bit_cast<uint64_t>(d);
+}
+
+struct UnionFind {
+  std::vector<uint32_t> parent;
+  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  uint32_t Find(uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void Union(uint32_t a, uint32_t b) {
+    a = Find(a);
+    b = Find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// Three vertices of a face spanning its plane, or false if all are collinear.
+bool PlaneTriple(const std::vector<Vec3>& v, const std::vector<uint32_t>& f, std::array<uint32_t, 3>* t) {
+  const uint32_t a = f[0];
+  for (size_t i = 1; i < f.size(); ++i) {
+    if (v[f[i]] == v[a]) continue;
+    for (size_t j = i + 1; j < f.size(); ++j) {
+      for (int drop = 0; drop < 3; ++drop) {
+        if (Orient2dSign(v[a], v[f[i]], v[f[j]], drop) != 0) {
+          *t = {a, f[i], f[j]};
+          return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+bool OnPlane(const std::vector<Vec3>& v, const std::array<uint32_t, 3>& t, const std::vector<uint32_t>& f) {
+  for (uint32_t x : f) {
+    if (x == t[0] || x == t[1] || x == t[2]) continue;  // trivially on it
+    if (Orient3dSign(v[t[0]], v[t[1]], v[t[2]], v[x]) != 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar) {
+  Plc plc;
+  plc.is_surface = true;
+  plc.index_base = soup.index_base;
+  plc.input_face_count = static_cast<uint32_t>(soup.faces.size());
+  plc.marker_names = std::move(soup.marker_names);
+  if (merge_vertices) {
+    // Exactly equal coordinates -> one vertex; first occurrence order kept.
+    std::vector<uint32_t> order(soup.vertices.size());
+    std::iota(order.begin(), order.end(), 0u);
+    auto key = [&](uint32_t i) {
+      const Vec3& p = soup.vertices[i];
+      return std::array<uint64_t, 3>{Bits(p.x), Bits(p.y), Bits(p.z)};
+    };
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
+    std::vector<uint32_t> rep(soup.vertices.size());
+    for (size_t k = 0; k < order.size();) {
+      size_t e = k;
+      while (e < order.size() && key(order[e]) == key(order[k])) ++e;
+      for (size_t q = k; q < e; ++q) rep[order[q]] = order[k];  // smallest index (stable)
+      k = e;
+    }
+    std::vector<uint32_t> new_id(soup.vertices.size(), UINT32_MAX);
+    for (uint32_t i = 0; i < soup.vertices.size(); ++i) {
+      if (rep[i] == i) {
+        new_id[i] = static_cast<uint32_t>(plc.vertices.size());
+        plc.vertices.push_back(soup.vertices[i]);
+        plc.vertex_lines.push_back(soup.vertex_lines[i]);
+        if (!soup.vertex_markers.empty()) plc.vertex_markers.push_back(soup.vertex_markers[i]);
+      }
+    }
+    for (auto& f : soup.faces) {
+      for (uint32_t& x : f) x = new_id[rep[x]];
+    }
+    for (Segment& s : soup.segments) {
+      s.a = new_id[rep[s.a]];
+      s.b = new_id[rep[s.b]];
+    }
+  } else {
+    plc.vertices = std::move(soup.vertices);
+    plc.vertex_lines = std::move(soup.vertex_lines);
+    plc.vertex_markers = std::move(soup.vertex_markers);
+  }
+  plc.segments = std::move(soup.segments);
+  const auto& V = plc.vertices;
+  const size_t nf = soup.faces.size();
+
+  auto emit_face = [&](uint32_t f) {
+    Facet facet;
+    facet.polygons.push_back({soup.faces[f]});
+    facet.marker = soup.face_markers[f];
+    facet.input_faces = {f};
+    plc.facets.push_back(std::move(facet));
+    plc.facet_lines.push_back(soup.face_lines[f]);
+  };
+  if (!merge_coplanar) {
+    for (uint32_t f = 0; f < nf; ++f) emit_face(f);
+    return plc;
+  }
+
+  // Planes of faces that are exactly planar and non-degenerate.
+  std::vector<std::array<uint32_t, 3>> plane(nf);
+  std::vector<bool> mergeable(nf, false);
+  for (uint32_t f = 0; f < nf; ++f) {
+    const auto& face = soup.faces[f];
+    bool distinct = true;  // no repeated vertex in the face
+    std::vector<uint32_t> s = face;
+    std::sort(s.begin(), s.end());
+    distinct = std::adjacent_find(s.begin(), s.end()) == s.end();
+    mergeable[f] = distinct && PlaneTriple(V, face, &plane[f]) && OnPlane(V, plane[f], face);
+  }
+  // Directed edges -> faces. An undirected edge used by exactly two faces, in
+  // opposite directions (consistent orientation), joins them if coplanar with
+  // equal markers.
+  struct E {
+    uint32_t lo, hi, face;
+    bool forward;
+  };
+  std::vector<E> edges;
+  for (uint32_t f = 0; f < nf; ++f) {
+    const auto& face = soup.faces[f];
+    for (size_t i = 0; i < face.size(); ++i) {
+      const uint32_t a = face[i], b = face[(i + 1) % face.size()];
+      if (a == b) continue;
+      edges.push_back({std::min(a, b), std::max(a, b), f, a < b});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const E& x, const E& y) {
+    return std::tie(x.lo, x.hi, x.face) < std::tie(y.lo, y.hi, y.face);
+  });
+  UnionFind uf(nf);
+  for (size_t k = 0; k < edges.size();) {
+    size_t e = k;
+    while (e < edges.size() && edges[e].lo == edges[k].lo && edges[e].hi == edges[k].hi) ++e;
+    if (e - k == 2) {
+      const E& x = edges[k];
+      const E& y = edges[k + 1];
+      if (x.face != y.face && x.forward != y.forward && mergeable[x.face] && mergeable[y.face] &&
+          soup.face_markers[x.face] == soup.face_markers[y.face] &&
+          OnPlane(V, plane[x.face], soup.faces[y.face])) {
+        uf.Union(x.face, y.face);
+      }
+    }
+    k = e;
+  }
+  // Groups in order of their first face.
+  std::map<uint32_t, std::vector<uint32_t>> groups;
+  for (uint32_t f = 0; f < nf; ++f) groups[uf.Find(f)].push_back(f);
+  std::vector<std::vector<uint32_t>> ordered;
+  for (auto& [root, faces] : groups) ordered.push_back(std::move(faces));
+  std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a[0] < b[0]; });
+
+  for (const auto& group : ordered) {
+    if (group.size() == 1) {
+      emit_face(group[0]);
+      continue;
+    }
+    // Boundary = directed edges whose reverse is not in the group.
+    std::map<std::pair<uint32_t, uint32_t>, int> count;
+    for (uint32_t f : group) {
+      const auto& face = soup.faces[f];
+      for (size_t i = 0; i < face.size(); ++i) {
+        const uint32_t a = face[i], b = face[(i + 1) % face.size()];
+        ++count[{a, b}];
+      }
+    }
+    std::map<uint32_t, std::vector<uint32_t>> out;  // boundary successor(s)
+    bool ok = true;
+    size_t nboundary = 0;
+    for (const auto& [ab, c] : count) {
+      auto rev = count.find({ab.second, ab.first});
+      const int r = rev == count.end() ? 0 : rev->second;
+      if (c > 1 || r > 1) ok = false;
+      if (r == 0) {
+        out[ab.first].push_back(ab.second);
+        ++nboundary;
+      }
+    }
+    for (const auto& [v, succ] : out) ok = ok && succ.size() == 1;  // no pinch vertices
+    std::vector<std::vector<uint32_t>> loops;
+    if (ok) {
+      std::map<uint32_t, bool> used;
+      for (const auto& [start, succ] : out) {
+        if (used[start]) continue;
+        std::vector<uint32_t> loop;
+        uint32_t v = start;
+        while (!used[v]) {
+          used[v] = true;
+          loop.push_back(v);
+          auto it = out.find(v);
+          if (it == out.end()) {
+            ok = false;
+            break;
+          }
+          v = it->second[0];
+        }
+        if (!ok || v != start || loop.size() < 3) {
+          ok = false;
+          break;
+        }
+        loops.push_back(std::move(loop));
+      }
+    }
+    Facet facet;
+    int drop = 2;
+    if (ok) {
+      const auto& t = plane[group[0]];
+      const Vec3 n = geom::Cross(V[t[1]] - V[t[0]], V[t[2]] - V[t[0]]);
+      drop = DropAxis(n);
+      // The group's orientation in the projection: the outer loop turns the
+      // same way as its faces, hole loops the other way.
+      const int face_orient = LoopOrientation(V, soup.faces[group[0]], drop);
+      size_t outer_count = 0;
+      for (auto& loop : loops) {
+        const int o = LoopOrientation(V, loop, drop);
+        if (o == 0) {
+          ok = false;
+          break;
+        }
+        if (o == face_orient) {
+          ++outer_count;
+          facet.polygons.insert(facet.polygons.begin(), Polygon{loop});
+        } else {
+          Vec3 seed;
+          if (!PointInsideLoop(V, loop, drop, &seed)) {
+            ok = false;
+            break;
+          }
+          facet.polygons.push_back(Polygon{loop});
+          facet.holes.push_back(seed);
+        }
+      }
+      ok = ok && outer_count == 1;
+    }
+    if (!ok) {
+      // Not a simple polygon with holes (pinch vertex, inconsistent
+      // orientation): keep the faces as they are.
+      for (uint32_t f : group) emit_face(f);
+      continue;
+    }
+    facet.marker = soup.face_markers[group[0]];
+    facet.input_faces = group;
+    plc.facets.push_back(std::move(facet));
+    plc.facet_lines.push_back(soup.face_lines[group[0]]);
+    (void)nboundary;
+  }
+  return plc;
+}
+
+}  // namespace svrc::plc::internal
