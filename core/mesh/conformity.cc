@@ -1,0 +1,1043 @@
+#include "core/mesh/conformity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <set>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/geometry/predicates.h"
+
+namespace svrc::mesh {
+namespace {
+
+using geom::Box3;
+using geom::Cross;
+using geom::Dot;
+using geom::Norm;
+
+constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+constexpr double kEps52 = 0x1p-52;
+
+// Local face k of a tet is the one opposite vertex k. Faces are matched as
+// sorted triples; sides are decided by Orient3d, not by the listing order.
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+// ----------------------------------------------------------------- report
+
+void Add(ConformityReport* r, const ConformityOptions& o, ViolationKind k,
+         std::vector<int64_t> ids, std::string msg) {
+  size_t& c = r->counts[static_cast<int>(k)];
+  if (c < o.max_listed_per_kind) r->violations.push_back({k, std::move(ids), std::move(msg)});
+  ++c;
+}
+
+// ------------------------------------------------------------ spatial grid
+
+// A uniform grid over a box; items (tets, facets) are registered in every
+// cell their bounding box overlaps (CSR storage). Queries may return an item
+// more than once; callers deduplicate with a stamp.
+class BoxGrid {
+ public:
+  template <typename BoxOf>
+  BoxGrid(const Box3& domain, size_t num_items, size_t items_per_cell, int max_res,
+          BoxOf box_of)
+      : domain_(domain) {
+    const double cells = std::max<double>(1.0, static_cast<double>(num_items) / items_per_cell);
+    const int r = std::clamp(static_cast<int>(std::cbrt(cells)), 1, max_res);
+    for (int a = 0; a < 3; ++a) {
+      res_[a] = r;
+      const double ext = domain.hi[a] - domain.lo[a];
+      inv_[a] = ext > 0 ? r / ext : 0.0;
+    }
+    start_.assign(static_cast<size_t>(r) * r * r + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (size_t i = 0; i < num_items; ++i) {
+        const Box3 b = box_of(i);
+        if (b.Empty()) continue;
+        ForCells(b, [&](size_t c) {
+          if (pass == 0) {
+            ++start_[c + 1];
+          } else {
+            items_[fill_[c]++] = static_cast<uint32_t>(i);
+          }
+        });
+      }
+      if (pass == 0) {
+        std::partial_sum(start_.begin(), start_.end(), start_.begin());
+        items_.resize(start_.back());
+        fill_.assign(start_.begin(), start_.end() - 1);
+      }
+    }
+  }
+
+  template <typename F>
+  void Query(const Box3& b, F&& f) const {
+    ForCells(b, [&](size_t c) {
+      for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) f(items_[k]);
+    });
+  }
+
+ private:
+  int CellOf(double v, int a) const {
+    const double t = std::floor((v - domain_.lo[a]) * inv_[a]);
+    if (!(t > 0)) return 0;
+    return t >= res_[a] - 1 ? res_[a] - 1 : static_cast<int>(t);
+  }
+  template <typename F>
+  void ForCells(const Box3& b, F&& f) const {
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = CellOf(b.lo[a], a);
+      hi[a] = CellOf(b.hi[a], a);
+    }
+    for (int z = lo[2]; z <= hi[2]; ++z) {
+      for (int y = lo[1]; y <= hi[1]; ++y) {
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          f((static_cast<size_t>(z) * res_[1] + y) * res_[0] + x);
+        }
+      }
+    }
+  }
+
+  Box3 domain_;
+  int res_[3];
+  double inv_[3];
+  std::vector<uint32_t> start_, fill_, items_;
+};
+
+Box3 Expand(Box3 b, double d) {
+  b.lo = b.lo - Vec3(d, d, d);
+  b.hi = b.hi + Vec3(d, d, d);
+  return b;
+}
+
+// ------------------------------------------------------------- facet model
+
+struct Plane {
+  Vec3 a, b, c;  // three input points, not collinear
+  Vec3 n;        // unit normal (floating point, for tolerances and areas)
+  int axis = 2;  // dominant axis of n: the projection drops it
+};
+
+struct Loop {
+  std::vector<Vec3> pts;
+  std::vector<uint32_t> ids;
+  bool outer = false;
+  bool hole = false;
+  double area = 0;  // 3D area (unsigned)
+};
+
+struct FacetGeom {
+  bool valid = false;
+  Plane plane;
+  std::vector<Loop> loops;
+  double area = 0;
+  Box3 box;
+  int32_t marker = 0;
+};
+
+// Side of p with respect to the plane: the exact sign, except that points
+// within `tol` of the plane count as on it (docs/conformity.md).
+int SideOf(const Plane& pl, const Vec3& p, double tol) {
+  const int s = geom::Orient3d(pl.a, pl.b, pl.c, p);
+  if (s == 0) return 0;
+  if (std::fabs(Dot(pl.n, p - pl.a)) <= tol) return 0;
+  return s;
+}
+
+// Projected 2D coordinates (the axes after `axis`, cyclically), as in
+// geom::Orient2dProjected.
+inline double U(const Vec3& p, int axis) { return p[(axis + 1) % 3]; }
+inline double V(const Vec3& p, int axis) { return p[(axis + 2) % 3]; }
+
+// +1 strictly inside the closed polygon, 0 on its boundary, -1 outside; q is
+// assumed to lie on the polygon's plane. Exact crossing-number test on the
+// projection.
+int PointInLoop(const std::vector<Vec3>& loop, const Vec3& q, int axis) {
+  bool inside = false;
+  const double qu = U(q, axis), qv = V(q, axis);
+  for (size_t i = 0, n = loop.size(); i < n; ++i) {
+    const Vec3& p = loop[i];
+    const Vec3& r = loop[(i + 1) % n];
+    const int o = geom::Orient2dProjected(p, r, q, axis);
+    if (o == 0 && qu >= std::min(U(p, axis), U(r, axis)) && qu <= std::max(U(p, axis), U(r, axis)) &&
+        qv >= std::min(V(p, axis), V(r, axis)) && qv <= std::max(V(p, axis), V(r, axis))) {
+      return 0;
+    }
+    const bool p_above = V(p, axis) > qv, r_above = V(r, axis) > qv;
+    if (p_above != r_above) {
+      // The edge crosses the line v = qv; count it when the crossing is on
+      // the +u side of q, i.e. q is left of the upward-directed edge.
+      const bool up = r_above;
+      if (up ? o > 0 : o < 0) inside = !inside;
+    }
+  }
+  return inside ? 1 : -1;
+}
+
+bool InFacetRegion(const FacetGeom& f, const Vec3& q) {
+  bool in_outer = false;
+  for (const Loop& l : f.loops) {
+    if (l.outer && !l.hole && PointInLoop(l.pts, q, f.plane.axis) >= 0) {
+      in_outer = true;
+      break;
+    }
+  }
+  if (!in_outer) return false;
+  for (const Loop& l : f.loops) {
+    if (l.hole && PointInLoop(l.pts, q, f.plane.axis) > 0) return false;
+  }
+  return true;
+}
+
+// Vector area of a closed polygon, relative to its first point.
+Vec3 VectorArea(const std::vector<Vec3>& pts) {
+  Vec3 s;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) s += Cross(pts[i] - pts[0], pts[i + 1] - pts[0]);
+  return 0.5 * s;
+}
+
+FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet, double tol) {
+  FacetGeom f;
+  f.marker = facet.marker;
+  std::vector<uint32_t> all;
+  for (const auto& poly : facet.polygons) {
+    for (uint32_t v : poly.vertices) {
+      if (v >= plc.vertices.size()) return f;  // dangling index: invalid input
+      all.push_back(v);
+      f.box.Add(plc.vertices[v]);
+    }
+  }
+  if (all.size() < 3) return f;
+  // Plane through three input points: a, the farthest point from a, and the
+  // point farthest from that line (the best-conditioned triple cheaply).
+  const Vec3 a = plc.vertices[all[0]];
+  Vec3 b = a, c = a;
+  double best = 0;
+  for (uint32_t v : all) {
+    const double d = geom::Dist2(a, plc.vertices[v]);
+    if (d > best) best = d, b = plc.vertices[v];
+  }
+  best = 0;
+  for (uint32_t v : all) {
+    const double d = geom::Norm2(Cross(b - a, plc.vertices[v] - a));
+    if (d > best) best = d, c = plc.vertices[v];
+  }
+  if (best == 0) return f;  // collinear: zero-area facet
+  f.plane.a = a;
+  f.plane.b = b;
+  f.plane.c = c;
+  const Vec3 n = Cross(b - a, c - a);
+  f.plane.n = n / Norm(n);
+  f.plane.axis = geom::DominantAxis(n);
+  for (uint32_t v : all) {
+    if (SideOf(f.plane, plc.vertices[v], tol) != 0) return f;  // not planar
+  }
+  for (const auto& poly : facet.polygons) {
+    if (poly.vertices.size() < 3) continue;
+    Loop l;
+    l.ids = poly.vertices;
+    for (uint32_t v : poly.vertices) l.pts.push_back(plc.vertices[v]);
+    l.area = Norm(VectorArea(l.pts));
+    f.loops.push_back(std::move(l));
+  }
+  if (f.loops.empty()) return f;
+  const int axis = f.plane.axis;
+  // Outer loops: not contained in another loop (all vertices inside or on it,
+  // one strictly inside).
+  const size_t nl = f.loops.size();
+  std::vector<std::vector<bool>> inside(nl, std::vector<bool>(nl, false));
+  for (size_t i = 0; i < nl; ++i) {
+    for (size_t j = 0; j < nl; ++j) {
+      if (i == j) continue;
+      bool all_in = true, one_strict = false;
+      for (const Vec3& p : f.loops[i].pts) {
+        const int s = PointInLoop(f.loops[j].pts, p, axis);
+        all_in = all_in && s >= 0;
+        one_strict = one_strict || s > 0;
+      }
+      inside[i][j] = all_in && one_strict;
+    }
+  }
+  for (size_t i = 0; i < nl; ++i) {
+    f.loops[i].outer = true;
+    for (size_t j = 0; j < nl; ++j) f.loops[i].outer = f.loops[i].outer && !inside[i][j];
+  }
+  // A facet hole seed removes the innermost loop strictly containing it.
+  for (const Vec3& h : facet.holes) {
+    size_t best_loop = nl;
+    for (size_t i = 0; i < nl; ++i) {
+      if (PointInLoop(f.loops[i].pts, h, axis) <= 0) continue;
+      if (best_loop == nl || inside[i][best_loop]) best_loop = i;
+    }
+    if (best_loop < nl) f.loops[best_loop].hole = true;
+  }
+  for (const Loop& l : f.loops) {
+    if (l.hole) {
+      f.area -= l.outer ? 0 : l.area;
+    } else if (l.outer) {
+      f.area += l.area;
+    }
+  }
+  f.valid = true;
+  return f;
+}
+
+// --------------------------------------------------- 2D clipping for crossing
+
+using P2 = std::array<double, 2>;
+
+double SignedArea2(const std::vector<P2>& p) {
+  double s = 0;
+  for (size_t i = 0, n = p.size(); i < n; ++i) {
+    const P2& a = p[i];
+    const P2& b = p[(i + 1) % n];
+    s += a[0] * b[1] - a[1] * b[0];
+  }
+  return 0.5 * s;
+}
+
+// Sutherland–Hodgman: subject (any simple polygon) clipped by a convex
+// counter-clockwise polygon. The area of the result is the area of the
+// intersection even for a non-convex subject.
+std::vector<P2> ClipConvex(std::vector<P2> subject, const std::vector<P2>& clip) {
+  for (size_t e = 0, m = clip.size(); e < m && !subject.empty(); ++e) {
+    const P2 c0 = clip[e], c1 = clip[(e + 1) % m];
+    auto side = [&](const P2& x) {
+      return (c1[0] - c0[0]) * (x[1] - c0[1]) - (c1[1] - c0[1]) * (x[0] - c0[0]);
+    };
+    std::vector<P2> out;
+    for (size_t i = 0, n = subject.size(); i < n; ++i) {
+      const P2 cur = subject[i], prev = subject[(i + n - 1) % n];
+      const double sc = side(cur), sp = side(prev);
+      if ((sc >= 0) != (sp >= 0)) {
+        const double t = sp / (sp - sc);
+        out.push_back({prev[0] + t * (cur[0] - prev[0]), prev[1] + t * (cur[1] - prev[1])});
+      }
+      if (sc >= 0) out.push_back(cur);
+    }
+    subject = std::move(out);
+  }
+  return subject;
+}
+
+// ------------------------------------------------------------- the checker
+
+class Checker {
+ public:
+  Checker(const plc::Plc* plc, const TetMesh& mesh, const ConformityOptions& opt,
+          ConformityReport* rep)
+      : plc_(plc), mesh_(mesh), opt_(opt), rep_(rep) {}
+
+  void Run() {
+    CheckIdsAndTags();
+    CheckTets();
+    CheckFaces();
+    CheckTriangles();
+    rep_->mesh_volume = MeshVolume();
+    if (plc_ == nullptr) return;
+    PrepareFacets();
+    CheckOpenFaces();
+    CheckVolume();
+    CheckInputVertices();
+    CheckSegments();
+    CheckFacetCoverage();
+    CheckCrossings();
+  }
+
+ private:
+  const Vec3& P(uint32_t v) const { return mesh_.positions[v]; }
+
+  void CheckIdsAndTags() {
+    const size_t nv = mesh_.positions.size();
+    tet_ok_.assign(mesh_.tets.size(), 1);
+    for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+      for (uint32_t v : mesh_.tets[t]) {
+        if (v >= nv) {
+          tet_ok_[t] = 0;
+          Add(rep_, opt_, ViolationKind::kIdOutOfRange, {static_cast<int64_t>(t), v},
+              absl::StrCat("tet ", t, " has vertex id ", v, " >= ", nv));
+          break;
+        }
+      }
+    }
+    tri_ok_.assign(mesh_.triangles.size(), 1);
+    for (size_t t = 0; t < mesh_.triangles.size(); ++t) {
+      for (uint32_t v : mesh_.triangles[t]) {
+        if (v >= nv) {
+          tri_ok_[t] = 0;
+          Add(rep_, opt_, ViolationKind::kIdOutOfRange, {static_cast<int64_t>(t), v},
+              absl::StrCat("triangle ", t, " has vertex id ", v, " >= ", nv));
+          break;
+        }
+      }
+    }
+    if (mesh_.tet_region.size() != mesh_.tets.size()) {
+      Add(rep_, opt_, ViolationKind::kTagCountMismatch, {},
+          absl::StrCat(mesh_.tet_region.size(), " tet regions for ", mesh_.tets.size(), " tets"));
+    } else if (!mesh_.regions.empty()) {
+      for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+        const int32_t r = mesh_.tet_region[t];
+        if (r < 0 || static_cast<size_t>(r) >= mesh_.regions.size()) {
+          Add(rep_, opt_, ViolationKind::kTagCountMismatch, {static_cast<int64_t>(t), r},
+              absl::StrCat("tet ", t, " has region id ", r, " of ", mesh_.regions.size()));
+        }
+      }
+    }
+    if (mesh_.triangle_marker.size() != mesh_.triangles.size()) {
+      Add(rep_, opt_, ViolationKind::kTagCountMismatch, {},
+          absl::StrCat(mesh_.triangle_marker.size(), " triangle markers for ",
+                       mesh_.triangles.size(), " triangles"));
+    }
+  }
+
+  void CheckTets() {
+    std::vector<std::pair<std::array<uint32_t, 4>, uint32_t>> sorted;
+    sorted.reserve(mesh_.tets.size());
+    for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+      if (!tet_ok_[t]) continue;
+      const auto& q = mesh_.tets[t];
+      const int s = geom::Orient3d(P(q[0]), P(q[1]), P(q[2]), P(q[3]));
+      if (s < 0) {
+        Add(rep_, opt_, ViolationKind::kFlippedTet, {static_cast<int64_t>(t)},
+            absl::StrCat("tet ", t, " (", q[0], " ", q[1], " ", q[2], " ", q[3],
+                         ") is negatively oriented"));
+      } else if (s == 0) {
+        Add(rep_, opt_, ViolationKind::kDegenerateTet, {static_cast<int64_t>(t)},
+            absl::StrCat("tet ", t, " (", q[0], " ", q[1], " ", q[2], " ", q[3], ") is flat"));
+      }
+      auto key = q;
+      std::sort(key.begin(), key.end());
+      sorted.push_back({key, static_cast<uint32_t>(t)});
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i) {
+      if (sorted[i].first == sorted[i - 1].first) {
+        Add(rep_, opt_, ViolationKind::kDuplicateTet, {sorted[i - 1].second, sorted[i].second},
+            absl::StrCat("tets ", sorted[i - 1].second, " and ", sorted[i].second,
+                         " have the same vertices"));
+      }
+    }
+  }
+
+  struct FaceRec {
+    std::array<uint32_t, 3> key;
+    uint32_t tet;
+    uint8_t local;
+    bool operator<(const FaceRec& o) const {
+      return key != o.key ? key < o.key : (tet != o.tet ? tet < o.tet : local < o.local);
+    }
+  };
+
+  void CheckFaces() {
+    faces_.reserve(4 * mesh_.tets.size());
+    for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+      if (!tet_ok_[t]) continue;
+      for (int k = 0; k < 4; ++k) {
+        std::array<uint32_t, 3> key = {mesh_.tets[t][kFace[k][0]], mesh_.tets[t][kFace[k][1]],
+                                       mesh_.tets[t][kFace[k][2]]};
+        std::sort(key.begin(), key.end());
+        faces_.push_back({key, static_cast<uint32_t>(t), static_cast<uint8_t>(k)});
+      }
+    }
+    std::sort(faces_.begin(), faces_.end());
+    for (size_t i = 0; i < faces_.size();) {
+      size_t j = i;
+      while (j < faces_.size() && faces_[j].key == faces_[i].key) ++j;
+      const auto& key = faces_[i].key;
+      if (j - i == 1) {
+        open_faces_.push_back(i);
+      } else if (j - i == 2) {
+        const uint32_t t1 = faces_[i].tet, t2 = faces_[i + 1].tet;
+        const uint32_t d1 = mesh_.tets[t1][faces_[i].local];
+        const uint32_t d2 = mesh_.tets[t2][faces_[i + 1].local];
+        const int s1 = geom::Orient3d(P(key[0]), P(key[1]), P(key[2]), P(d1));
+        const int s2 = geom::Orient3d(P(key[0]), P(key[1]), P(key[2]), P(d2));
+        if (s1 != 0 && s2 != 0 && s1 == s2) {
+          Add(rep_, opt_, ViolationKind::kNeighborsSameSide, {t1, t2},
+              absl::StrCat("tets ", t1, " and ", t2, " share face (", key[0], " ", key[1], " ",
+                           key[2], ") and lie on the same side of it"));
+        }
+      } else {
+        std::vector<int64_t> ids = {key[0], key[1], key[2]};
+        for (size_t k = i; k < j; ++k) ids.push_back(faces_[k].tet);
+        Add(rep_, opt_, ViolationKind::kFaceInMoreThanTwoTets, ids,
+            absl::StrCat("face (", key[0], " ", key[1], " ", key[2], ") is in ", j - i, " tets"));
+      }
+      i = j;
+    }
+  }
+
+  void CheckTriangles() {
+    std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> sorted;
+    for (size_t t = 0; t < mesh_.triangles.size(); ++t) {
+      if (!tri_ok_[t]) continue;
+      auto key = mesh_.triangles[t];
+      std::sort(key.begin(), key.end());
+      sorted.push_back({key, static_cast<uint32_t>(t)});
+      const FaceRec probe{key, 0, 0};
+      auto it = std::lower_bound(faces_.begin(), faces_.end(), probe);
+      if (it == faces_.end() || it->key != key) {
+        Add(rep_, opt_, ViolationKind::kTriangleNotAFace, {static_cast<int64_t>(t)},
+            absl::StrCat("triangle ", t, " (", key[0], " ", key[1], " ", key[2],
+                         ") is not a face of any tet"));
+      }
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i) {
+      if (sorted[i].first == sorted[i - 1].first) {
+        tri_ok_[sorted[i].second] = 0;  // count its area once
+        Add(rep_, opt_, ViolationKind::kDuplicateTriangle,
+            {sorted[i - 1].second, sorted[i].second},
+            absl::StrCat("triangles ", sorted[i - 1].second, " and ", sorted[i].second,
+                         " have the same vertices"));
+      }
+    }
+  }
+
+  double MeshVolume() {
+    Box3 box;
+    for (const Vec3& p : mesh_.positions) box.Add(p);
+    mesh_box_ = box;
+    const Vec3 o = box.Empty() ? Vec3() : box.Center();
+    double v = 0;
+    for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+      if (!tet_ok_[t]) continue;
+      const auto& q = mesh_.tets[t];
+      const Vec3 a = P(q[0]) - o;
+      v += Dot((P(q[1]) - o) - a, Cross((P(q[2]) - o) - a, (P(q[3]) - o) - a)) / 6.0;
+    }
+    return v;
+  }
+
+  // ------------------------------------------------------------ with a PLC
+
+  void PrepareFacets() {
+    double scale = 0;
+    for (const Vec3& p : plc_->vertices) {
+      scale = std::max({scale, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    }
+    tol_ = opt_.tolerance_ulps * kEps52 * scale;
+    facets_.reserve(plc_->facets.size());
+    for (const auto& f : plc_->facets) facets_.push_back(BuildFacet(*plc_, f, tol_));
+    for (const FacetGeom& f : facets_) rep_->num_facets_checked += f.valid ? 1 : 0;
+    Box3 all;
+    for (const FacetGeom& f : facets_) {
+      if (f.valid) {
+        all.Add(f.box.lo);
+        all.Add(f.box.hi);
+      }
+    }
+    all = Expand(all, tol_);
+    facet_grid_ = std::make_unique<BoxGrid>(all, facets_.size(), 1, 64, [&](size_t i) {
+      return facets_[i].valid ? Expand(facets_[i].box, tol_) : Box3();
+    });
+    facet_stamp_.assign(facets_.size(), kNone);
+  }
+
+  // Calls f(facet index) for every valid facet containing the triangle abc
+  // (vertices on its plane, centroid in its region), each once.
+  template <typename F>
+  void ForFacetsContaining(const Vec3& a, const Vec3& b, const Vec3& c, F&& f) {
+    const Vec3 g = (a + b + c) / 3.0;
+    Box3 q;
+    q.Add(g);
+    ++query_;
+    facet_grid_->Query(q, [&](uint32_t i) {
+      if (facet_stamp_[i] == query_) return;
+      facet_stamp_[i] = query_;
+      const FacetGeom& fg = facets_[i];
+      if (SideOf(fg.plane, a, tol_) != 0 || SideOf(fg.plane, b, tol_) != 0 ||
+          SideOf(fg.plane, c, tol_) != 0) {
+        return;
+      }
+      // The centroid is rounded; project it onto the plane's coordinates by
+      // using it only in the 2D tests (which ignore the dropped axis).
+      if (!InFacetRegion(fg, g)) return;
+      f(i);
+    });
+  }
+
+  bool OnBoxBoundary(const Vec3& a, const Vec3& b, const Vec3& c) const {
+    for (int ax = 0; ax < 3; ++ax) {
+      for (double w : {mesh_box_.lo[ax], mesh_box_.hi[ax]}) {
+        if (a[ax] == w && b[ax] == w && c[ax] == w) return true;
+      }
+    }
+    return false;
+  }
+
+  void CheckOpenFaces() {
+    for (size_t i : open_faces_) {
+      const auto& k = faces_[i].key;
+      if (opt_.keep_bounding_box && OnBoxBoundary(P(k[0]), P(k[1]), P(k[2]))) continue;
+      bool on_facet = false;
+      ForFacetsContaining(P(k[0]), P(k[1]), P(k[2]), [&](uint32_t) { on_facet = true; });
+      if (!on_facet) {
+        Add(rep_, opt_, ViolationKind::kOpenFace, {faces_[i].tet, faces_[i].local},
+            absl::StrCat("face (", k[0], " ", k[1], " ", k[2], ") of tet ", faces_[i].tet,
+                         " is in no other tet and on no input facet",
+                         opt_.keep_bounding_box ? " or the bounding box" : ""));
+      }
+    }
+  }
+
+  // Enclosed volume by the divergence theorem, when the valid facets form
+  // closed, consistently orientable surfaces whose bounding boxes are
+  // disjoint, and there are no volume holes (docs/conformity.md).
+  void CheckVolume() {
+    if (opt_.keep_bounding_box) {
+      if (!mesh_box_.Empty()) {
+        const Vec3 e = mesh_box_.hi - mesh_box_.lo;
+        rep_->enclosed_volume = e.x * e.y * e.z;
+        rep_->enclosed_volume_known = true;
+      }
+    } else {
+      ComputeEnclosedVolume();
+    }
+    if (!rep_->enclosed_volume_known) return;
+    const double ve = rep_->enclosed_volume, vm = rep_->mesh_volume;
+    if (std::fabs(vm - ve) > opt_.volume_rel_tol * std::fabs(ve)) {
+      Add(rep_, opt_, ViolationKind::kVolumeMismatch, {},
+          absl::StrFormat("total tet volume %.17g != enclosed volume %.17g (relative %.3g)", vm,
+                          ve, std::fabs(vm - ve) / std::max(std::fabs(ve), 1e-300)));
+    }
+  }
+
+  void ComputeEnclosedVolume() {
+    if (!plc_->holes.empty() || facets_.empty()) return;
+    // Directed boundary edges: (facet, loop direction sign, u, v).
+    struct Edge {
+      std::array<uint32_t, 2> key;
+      uint32_t facet;
+      int dir;  // +1 when the facet's orientation traverses key[0] -> key[1]
+    };
+    std::vector<Edge> edges;
+    std::vector<Vec3> normal(facets_.size());
+    for (size_t f = 0; f < facets_.size(); ++f) {
+      const FacetGeom& fg = facets_[f];
+      if (!fg.valid) return;  // invalid facet: unknown
+      const Loop* ref = nullptr;
+      for (const Loop& l : fg.loops) {
+        if (l.outer && !l.hole) {
+          ref = &l;
+          break;
+        }
+      }
+      if (ref == nullptr) continue;
+      normal[f] = VectorArea(ref->pts);
+      for (const Loop& l : fg.loops) {
+        if (!l.outer && !l.hole) continue;  // a subdivision inside the facet
+        if (l.outer && l.hole) continue;
+        const double d = Dot(VectorArea(l.pts), normal[f]);
+        const int sign = (d > 0 ? 1 : -1) * (l.hole ? -1 : 1);
+        for (size_t i = 0, n = l.ids.size(); i < n; ++i) {
+          uint32_t u = l.ids[i], v = l.ids[(i + 1) % n];
+          if (u == v) continue;
+          const int dir = u < v ? sign : -sign;
+          edges.push_back({{std::min(u, v), std::max(u, v)}, static_cast<uint32_t>(f), dir});
+        }
+      }
+    }
+    std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) {
+      return a.key != b.key ? a.key < b.key : a.facet < b.facet;
+    });
+    // Every edge in exactly two facets; union-find free BFS over facets.
+    std::vector<std::vector<std::pair<uint32_t, int>>> adj(facets_.size());
+    for (size_t i = 0; i < edges.size();) {
+      size_t j = i;
+      while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+      if (j - i != 2 || edges[i].facet == edges[i + 1].facet) return;  // not a closed 2-manifold
+      // Consistent orientation: the two facets traverse the edge in opposite
+      // directions, i.e. relative sign = -dir_i * dir_j.
+      const int rel = -edges[i].dir * edges[i + 1].dir;
+      adj[edges[i].facet].push_back({edges[i + 1].facet, rel});
+      adj[edges[i + 1].facet].push_back({edges[i].facet, rel});
+      i = j;
+    }
+    std::vector<int> orient(facets_.size(), 0);
+    Box3 plc_box;
+    for (const Vec3& p : plc_->vertices) plc_box.Add(p);
+    const Vec3 o = plc_box.Center();
+    std::vector<Box3> comp_boxes;
+    double total = 0;
+    for (size_t s = 0; s < facets_.size(); ++s) {
+      if (orient[s] != 0 || facets_[s].area == 0) continue;
+      orient[s] = 1;
+      std::vector<uint32_t> stack = {static_cast<uint32_t>(s)};
+      double vol = 0;
+      Box3 box;
+      while (!stack.empty()) {
+        const uint32_t f = stack.back();
+        stack.pop_back();
+        const FacetGeom& fg = facets_[f];
+        box.Add(fg.box.lo);
+        box.Add(fg.box.hi);
+        const Vec3 n = normal[f] / Norm(normal[f]);
+        vol += orient[f] * fg.area * Dot(n, fg.plane.a - o) / 3.0;
+        for (auto [g, rel] : adj[f]) {
+          const int want = orient[f] * rel;
+          if (orient[g] == 0) {
+            orient[g] = want;
+            stack.push_back(g);
+          } else if (orient[g] != want) {
+            return;  // not orientable
+          }
+        }
+      }
+      for (const Box3& b : comp_boxes) {
+        const bool disjoint = b.hi.x < box.lo.x || box.hi.x < b.lo.x || b.hi.y < box.lo.y ||
+                              box.hi.y < b.lo.y || b.hi.z < box.lo.z || box.hi.z < b.lo.z;
+        if (!disjoint) return;  // possibly nested shells: unknown
+      }
+      comp_boxes.push_back(box);
+      total += std::fabs(vol);
+    }
+    rep_->enclosed_volume = total;
+    rep_->enclosed_volume_known = true;
+  }
+
+  void CheckInputVertices() {
+    const size_t nv = mesh_.positions.size();
+    std::vector<uint32_t> order(nv);
+    std::iota(order.begin(), order.end(), 0u);
+    auto less = [](const Vec3& a, const Vec3& b) {
+      return a.x != b.x ? a.x < b.x : (a.y != b.y ? a.y < b.y : a.z < b.z);
+    };
+    std::sort(order.begin(), order.end(), [&](uint32_t i, uint32_t j) {
+      return less(P(i), P(j)) || (P(i) == P(j) && i < j);
+    });
+    input_map_.assign(plc_->vertices.size(), kNone);
+    for (size_t i = 0; i < plc_->vertices.size(); ++i) {
+      const Vec3& p = plc_->vertices[i];
+      if (opt_.input_vertices_first && i < nv && P(static_cast<uint32_t>(i)) == p) {
+        input_map_[i] = static_cast<uint32_t>(i);
+        continue;
+      }
+      auto it = std::lower_bound(order.begin(), order.end(), p,
+                                 [&](uint32_t v, const Vec3& q) { return less(P(v), q); });
+      if (it == order.end() || !(P(*it) == p)) {
+        Add(rep_, opt_, ViolationKind::kMissingInputVertex, {static_cast<int64_t>(i)},
+            absl::StrFormat("input vertex %d (%.17g, %.17g, %.17g) is not a mesh vertex", i, p.x,
+                            p.y, p.z));
+        continue;
+      }
+      input_map_[i] = *it;
+      if (opt_.input_vertices_first) {
+        Add(rep_, opt_, ViolationKind::kInputVertexIndex, {static_cast<int64_t>(i), *it},
+            absl::StrCat("input vertex ", i, " is mesh vertex ", *it, ", expected ", i));
+      }
+    }
+  }
+
+  // Vertex -> neighbour lists of the mesh edges (CSR).
+  void BuildEdges() {
+    std::vector<std::pair<uint32_t, uint32_t>> e;
+    e.reserve(12 * mesh_.tets.size());
+    for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+      if (!tet_ok_[t]) continue;
+      const auto& q = mesh_.tets[t];
+      for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+          if (i != j) e.push_back({q[i], q[j]});
+        }
+      }
+    }
+    std::sort(e.begin(), e.end());
+    e.erase(std::unique(e.begin(), e.end()), e.end());
+    adj_start_.assign(mesh_.positions.size() + 1, 0);
+    for (const auto& [u, v] : e) ++adj_start_[u + 1];
+    std::partial_sum(adj_start_.begin(), adj_start_.end(), adj_start_.begin());
+    adj_.resize(e.size());
+    for (size_t i = 0; i < e.size(); ++i) adj_[i] = e[i].second;  // sorted by u
+  }
+
+  // p lies on the line ab: exactly (all three projections collinear) or within tol.
+  bool OnLine(const Vec3& a, const Vec3& b, const Vec3& p) const {
+    if (geom::Orient2dProjected(a, b, p, 0) == 0 && geom::Orient2dProjected(a, b, p, 1) == 0 &&
+        geom::Orient2dProjected(a, b, p, 2) == 0) {
+      return true;
+    }
+    const Vec3 d = b - a;
+    const double dist = Norm(Cross(d, p - a)) / Norm(d);
+    return dist <= tol_;
+  }
+
+  void CheckSegments() {
+    const auto segs = ConformitySegments(*plc_);
+    BuildEdges();
+    rep_->num_segments_checked = segs.size();
+    for (size_t s = 0; s < segs.size(); ++s) {
+      if (segs[s][0] >= input_map_.size() || segs[s][1] >= input_map_.size()) continue;
+      const uint32_t va = input_map_[segs[s][0]], vb = input_map_[segs[s][1]];
+      if (va == kNone || vb == kNone) continue;  // already reported
+      const Vec3 a = P(va), b = P(vb), d = b - a;
+      const double len2 = Dot(d, d);
+      uint32_t cur = va;
+      double cur_t = 0;
+      for (size_t steps = 0; cur != vb && steps <= mesh_.positions.size(); ++steps) {
+        // The next chain vertex: the neighbour on the segment that advances
+        // least beyond the current one (exactly one on a conforming mesh).
+        uint32_t next = kNone;
+        double next_t = 0;
+        for (uint32_t k = adj_start_[cur]; k < adj_start_[cur + 1]; ++k) {
+          const uint32_t w = adj_[k];
+          const double t = Dot(P(w) - a, d) / len2;
+          if (!(t > cur_t) || t > 1 + 1e-12) continue;
+          if (w != vb && !OnLine(a, b, P(w))) continue;
+          if (next == kNone || t < next_t) next = w, next_t = t;
+        }
+        if (next == kNone) break;
+        cur = next;
+        cur_t = next_t;
+      }
+      if (cur != vb) {
+        Add(rep_, opt_, ViolationKind::kBrokenSegment, {static_cast<int64_t>(s), cur},
+            absl::StrCat("segment ", s, " (input vertices ", segs[s][0], " ", segs[s][1],
+                         ") is not a chain of mesh edges: the walk stops at mesh vertex ", cur));
+      }
+    }
+  }
+
+  void CheckFacetCoverage() {
+    std::vector<double> covered(facets_.size(), 0);
+    for (size_t t = 0; t < mesh_.triangles.size(); ++t) {
+      if (!tri_ok_[t]) continue;
+      const auto& k = mesh_.triangles[t];
+      const Vec3 &a = P(k[0]), &b = P(k[1]), &c = P(k[2]);
+      const double area = 0.5 * Norm(Cross(b - a, c - a));
+      bool found = false, marker_ok = false;
+      uint32_t first = kNone;
+      const bool has_marker = mesh_.triangle_marker.size() == mesh_.triangles.size();
+      ForFacetsContaining(a, b, c, [&](uint32_t f) {
+        found = true;
+        if (first == kNone) first = f;
+        covered[f] += area;
+        marker_ok = marker_ok || !has_marker || mesh_.triangle_marker[t] == facets_[f].marker;
+      });
+      if (!found) {
+        Add(rep_, opt_, ViolationKind::kTriangleOffFacet, {static_cast<int64_t>(t)},
+            absl::StrCat("triangle ", t, " (", k[0], " ", k[1], " ", k[2],
+                         ") lies on no input facet"));
+      } else if (opt_.check_markers && !marker_ok) {
+        Add(rep_, opt_, ViolationKind::kWrongMarker, {static_cast<int64_t>(t), first},
+            absl::StrCat("triangle ", t, " has marker ", mesh_.triangle_marker[t], ", facet ",
+                         first, " has marker ", facets_[first].marker));
+      }
+    }
+    for (size_t f = 0; f < facets_.size(); ++f) {
+      if (!facets_[f].valid) continue;
+      const double want = facets_[f].area;
+      if (std::fabs(covered[f] - want) > opt_.area_rel_tol * want) {
+        Add(rep_, opt_, ViolationKind::kFacetNotCovered, {static_cast<int64_t>(f)},
+            absl::StrFormat("facet %d: mesh triangles on it cover area %.17g, facet area %.17g", f,
+                            covered[f], want));
+      }
+    }
+  }
+
+  void CheckCrossings() {
+    if (mesh_box_.Empty() || mesh_.tets.empty()) return;
+    BoxGrid tet_grid(mesh_box_, mesh_.tets.size(), 4, 128, [&](size_t t) {
+      Box3 b;
+      if (tet_ok_[t]) {
+        for (uint32_t v : mesh_.tets[t]) b.Add(P(v));
+      }
+      return b;
+    });
+    std::vector<uint32_t> stamp(mesh_.tets.size(), kNone);
+    for (size_t f = 0; f < facets_.size(); ++f) {
+      const FacetGeom& fg = facets_[f];
+      if (!fg.valid || fg.area == 0) continue;
+      const int axis = fg.plane.axis;
+      std::vector<std::vector<P2>> loops2(fg.loops.size());
+      for (size_t l = 0; l < fg.loops.size(); ++l) {
+        for (const Vec3& p : fg.loops[l].pts) loops2[l].push_back({U(p, axis), V(p, axis)});
+      }
+      // Projected areas scale 3D areas by |n[axis]|.
+      const double proj = std::fabs(fg.plane.n[axis]);
+      tet_grid.Query(Expand(fg.box, tol_), [&](uint32_t t) {
+        if (stamp[t] == f) return;
+        stamp[t] = static_cast<uint32_t>(f);
+        const auto& q = mesh_.tets[t];
+        int side[4];
+        bool pos = false, neg = false;
+        for (int i = 0; i < 4; ++i) {
+          side[i] = SideOf(fg.plane, P(q[i]), tol_);
+          pos = pos || side[i] > 0;
+          neg = neg || side[i] < 0;
+        }
+        if (!pos || !neg) return;
+        // Cross-section of the tet with the plane, projected.
+        std::vector<P2> sec;
+        for (int i = 0; i < 4; ++i) {
+          if (side[i] == 0) sec.push_back({U(P(q[i]), axis), V(P(q[i]), axis)});
+        }
+        for (int i = 0; i < 4; ++i) {
+          for (int j = i + 1; j < 4; ++j) {
+            if (side[i] * side[j] >= 0) continue;
+            const Vec3 &pi = P(q[i]), &pj = P(q[j]);
+            const double di = Dot(fg.plane.n, pi - fg.plane.a);
+            const double dj = Dot(fg.plane.n, pj - fg.plane.a);
+            const double s = di / (di - dj);
+            const Vec3 x = pi + s * (pj - pi);
+            sec.push_back({U(x, axis), V(x, axis)});
+          }
+        }
+        if (sec.size() < 3) return;
+        // Order counter-clockwise around the centroid (convex, <= 4 points).
+        P2 c{0, 0};
+        for (const P2& p : sec) c = {c[0] + p[0] / sec.size(), c[1] + p[1] / sec.size()};
+        std::sort(sec.begin(), sec.end(), [&](const P2& x, const P2& y) {
+          return std::atan2(x[1] - c[1], x[0] - c[0]) < std::atan2(y[1] - c[1], y[0] - c[0]);
+        });
+        const double sec_area = std::fabs(SignedArea2(sec));
+        if (sec_area == 0) return;
+        double overlap = 0;
+        for (size_t l = 0; l < fg.loops.size(); ++l) {
+          const Loop& lp = fg.loops[l];
+          if (lp.hole == lp.outer) continue;  // subdivision, or an outer loop removed
+          const double a = std::fabs(SignedArea2(ClipConvex(loops2[l], sec)));
+          overlap += lp.outer ? a : -a;
+        }
+        if (overlap > 1e-9 * sec_area) {
+          Add(rep_, opt_, ViolationKind::kTetCrossesFacet, {t, static_cast<int64_t>(f)},
+              absl::StrFormat("tet %d crosses facet %d (overlap area %.3g)", t, f,
+                              overlap / proj));
+        }
+      });
+    }
+  }
+
+  const plc::Plc* plc_;
+  const TetMesh& mesh_;
+  const ConformityOptions& opt_;
+  ConformityReport* rep_;
+
+  std::vector<uint8_t> tet_ok_, tri_ok_;
+  std::vector<FaceRec> faces_;
+  std::vector<size_t> open_faces_;
+  Box3 mesh_box_;
+  double tol_ = 0;
+  std::vector<FacetGeom> facets_;
+  std::unique_ptr<BoxGrid> facet_grid_;
+  std::vector<uint32_t> facet_stamp_;
+  uint32_t query_ = 0;
+  std::vector<uint32_t> input_map_;
+  std::vector<uint32_t> adj_start_, adj_;
+};
+
+}  // namespace
+
+ConformityCategory CategoryOf(ViolationKind kind) {
+  if (kind <= ViolationKind::kDuplicateTriangle) return ConformityCategory::kValidity;
+  if (kind <= ViolationKind::kVolumeMismatch) return ConformityCategory::kCoverage;
+  return ConformityCategory::kConformity;
+}
+
+std::string_view KindName(ViolationKind kind) {
+  switch (kind) {
+    case ViolationKind::kIdOutOfRange: return "id_out_of_range";
+    case ViolationKind::kFlippedTet: return "flipped_tet";
+    case ViolationKind::kDegenerateTet: return "degenerate_tet";
+    case ViolationKind::kDuplicateTet: return "duplicate_tet";
+    case ViolationKind::kFaceInMoreThanTwoTets: return "face_in_more_than_two_tets";
+    case ViolationKind::kNeighborsSameSide: return "neighbors_same_side";
+    case ViolationKind::kTagCountMismatch: return "tag_count_mismatch";
+    case ViolationKind::kTriangleNotAFace: return "triangle_not_a_face";
+    case ViolationKind::kDuplicateTriangle: return "duplicate_triangle";
+    case ViolationKind::kOpenFace: return "open_face";
+    case ViolationKind::kVolumeMismatch: return "volume_mismatch";
+    case ViolationKind::kMissingInputVertex: return "missing_input_vertex";
+    case ViolationKind::kInputVertexIndex: return "input_vertex_index";
+    case ViolationKind::kBrokenSegment: return "broken_segment";
+    case ViolationKind::kFacetNotCovered: return "facet_not_covered";
+    case ViolationKind::kTriangleOffFacet: return "triangle_off_facet";
+    case ViolationKind::kWrongMarker: return "wrong_marker";
+    case ViolationKind::kTetCrossesFacet: return "tet_crosses_facet";
+  }
+  return "unknown";
+}
+
+std::string_view CategoryName(ConformityCategory category) {
+  switch (category) {
+    case ConformityCategory::kValidity: return "validity";
+    case ConformityCategory::kCoverage: return "coverage";
+    case ConformityCategory::kConformity: return "conformity";
+  }
+  return "unknown";
+}
+
+bool ConformityReport::ok() const {
+  for (size_t c : counts) {
+    if (c != 0) return false;
+  }
+  return true;
+}
+
+size_t ConformityReport::Count(ConformityCategory category) const {
+  size_t n = 0;
+  for (int k = 0; k < kNumViolationKinds; ++k) {
+    if (CategoryOf(static_cast<ViolationKind>(k)) == category) n += counts[k];
+  }
+  return n;
+}
+
+std::string ConformityReport::Summary() const {
+  std::string out;
+  absl::StrAppendFormat(&out, "mesh volume %.17g, enclosed volume %s\n", mesh_volume,
+                        enclosed_volume_known ? absl::StrFormat("%.17g", enclosed_volume)
+                                              : std::string("unknown"));
+  if (ok()) {
+    absl::StrAppend(&out, "no violations\n");
+    return out;
+  }
+  for (int k = 0; k < kNumViolationKinds; ++k) {
+    if (counts[k] == 0) continue;
+    const auto kind = static_cast<ViolationKind>(k);
+    out += std::string(CategoryName(CategoryOf(kind))) + "/" + std::string(KindName(kind)) + ": " +
+           std::to_string(counts[k]) + "\n";
+  }
+  for (const Violation& v : violations) absl::StrAppend(&out, "  ", v.message, "\n");
+  return out;
+}
+
+std::vector<std::array<uint32_t, 2>> ConformitySegments(const plc::Plc& plc) {
+  std::vector<std::array<uint32_t, 2>> out;
+  std::set<std::array<uint32_t, 2>> seen;
+  auto add = [&](uint32_t a, uint32_t b) {
+    if (a == b) return;
+    if (seen.insert({std::min(a, b), std::max(a, b)}).second) out.push_back({a, b});
+  };
+  for (const auto& s : plc.segments) add(s.a, s.b);
+  for (const auto& f : plc.facets) {
+    for (const auto& p : f.polygons) {
+      const size_t n = p.vertices.size();
+      if (n == 2) {
+        add(p.vertices[0], p.vertices[1]);
+      } else if (n >= 3) {
+        for (size_t i = 0; i < n; ++i) add(p.vertices[i], p.vertices[(i + 1) % n]);
+      }
+    }
+  }
+  return out;
+}
+
+ConformityReport CheckConformity(const plc::Plc& plc, const TetMesh& mesh,
+                                 const ConformityOptions& options) {
+  ConformityReport report;
+  Checker(&plc, mesh, options, &report).Run();
+  return report;
+}
+
+ConformityReport CheckValidity(const TetMesh& mesh, const ConformityOptions& options) {
+  ConformityReport report;
+  Checker(nullptr, mesh, options, &report).Run();
+  return report;
+}
+
+}  // namespace svrc::mesh

@@ -1,0 +1,352 @@
+#include "core/mesh/conformity.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/geometry/predicates.h"
+#include "gtest/gtest.h"
+#include "tests/mesh/mesh_test_util.h"
+
+namespace svrc::mesh {
+namespace {
+
+using testing::BoxPlc;
+using testing::KuhnBoxMesh;
+using testing::TotalVolume;
+
+const Vec3 kLo(0, 0, 0), kHi(1, 1, 1);
+
+void FixOrientation(TetMesh* m) {
+  for (auto& t : m->tets) {
+    const Vec3 a = m->positions[t[0]];
+    const double det = geom::Dot(m->positions[t[1]] - a,
+                                 geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a));
+    if (det < 0) std::swap(t[2], t[3]);
+  }
+  m->tet_region.assign(m->tets.size(), 0);
+  m->regions.resize(1);
+}
+
+TEST(Conformity, AcceptsKuhnBoxes) {
+  for (int n : {1, 2, 3}) {
+    const plc::Plc p = BoxPlc(kLo, kHi);
+    const TetMesh m = KuhnBoxMesh(p, n);
+    const ConformityReport r = CheckConformity(p, m);
+    EXPECT_TRUE(r.ok()) << "n=" << n << "\n" << r.Summary();
+    EXPECT_TRUE(r.enclosed_volume_known);
+    EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
+    EXPECT_NEAR(r.mesh_volume, 1.0, 1e-12);
+    EXPECT_EQ(r.num_facets_checked, 6u);
+    EXPECT_EQ(r.num_segments_checked, 12u);
+  }
+}
+
+TEST(Conformity, AcceptsInternalFacetAndFarOffset) {
+  const plc::Plc split = BoxPlc(kLo, kHi, /*split=*/true);
+  const ConformityReport r = CheckConformity(split, KuhnBoxMesh(split, 2));
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  // Internal facets make the facet complex non-manifold: volume unknown.
+  EXPECT_FALSE(r.enclosed_volume_known);
+  const plc::Plc far = BoxPlc(Vec3(1e6, 1e6, 1e6), Vec3(1e6 + 1000, 1e6 + 1000, 1e6 + 1000));
+  const ConformityReport r2 = CheckConformity(far, KuhnBoxMesh(far, 4));
+  EXPECT_TRUE(r2.ok()) << r2.Summary();
+  EXPECT_NEAR(r2.enclosed_volume, 1e9, 1e-3);
+}
+
+TEST(Conformity, KeepBoundingBox) {
+  // Only the internal facet is an input facet; the mesh fills the box.
+  plc::Plc p = BoxPlc(kLo, kHi, /*split=*/true);
+  TetMesh m = KuhnBoxMesh(p, 2);
+  p.facets.erase(p.facets.begin(), p.facets.begin() + 6);
+  std::vector<std::array<uint32_t, 3>> tris;
+  std::vector<int32_t> markers;
+  for (size_t i = 0; i < m.triangles.size(); ++i) {
+    if (m.triangle_marker[i] == 7) {
+      tris.push_back(m.triangles[i]);
+      markers.push_back(7);
+    }
+  }
+  m.triangles = tris;
+  m.triangle_marker = markers;
+  ConformityOptions opt;
+  opt.keep_bounding_box = true;
+  const ConformityReport r = CheckConformity(p, m, opt);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  EXPECT_TRUE(r.enclosed_volume_known);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-15);
+  // Without the flag the box faces are open faces.
+  const ConformityReport r2 = CheckConformity(p, m);
+  EXPECT_GT(r2.Count(ViolationKind::kOpenFace), 0u);
+  EXPECT_EQ(r2.Count(ConformityCategory::kCoverage), r2.Count(ViolationKind::kOpenFace));
+}
+
+// The corner tetrahedron o,a,b,c with Steiner points that doubles cannot put
+// exactly on the slanted facet and the slanted edge ab.
+struct SlantedCase {
+  plc::Plc plc;
+  TetMesh mesh;
+};
+SlantedCase Slanted() {
+  SlantedCase c;
+  c.plc.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t d, int32_t marker) {
+    plc::Facet f;
+    f.polygons.push_back({{a, b, d}});
+    f.marker = marker;
+    c.plc.facets.push_back(f);
+  };
+  tri(0, 1, 2, 1);  // z = 0
+  tri(0, 2, 3, 2);  // x = 0
+  tri(0, 3, 1, 3);  // y = 0
+  tri(1, 2, 3, 4);  // x + y + z = 1
+  TetMesh& m = c.mesh;
+  m.positions = c.plc.vertices;
+  m.num_input_vertices = 4;
+  m.positions.push_back(Vec3(2.0 / 3, 1.0 / 3, 0));          // 4: m on ab
+  m.positions.push_back(Vec3(1.0 / 3, 1.0 / 3, 1.0 / 3));    // 5: s on abc
+  m.tets = {{0, 1, 4, 5}, {0, 4, 2, 5}, {0, 2, 3, 5}, {0, 3, 1, 5}};
+  FixOrientation(&m);
+  m.triangles = {{0, 1, 4}, {0, 4, 2}, {0, 2, 3}, {0, 3, 1},
+                 {1, 4, 5}, {4, 2, 5}, {2, 3, 5}, {3, 1, 5}};
+  m.triangle_marker = {1, 1, 2, 3, 4, 4, 4, 4};
+  return c;
+}
+
+TEST(Conformity, SlantedSteinerPointsNeedTheTolerance) {
+  const SlantedCase c = Slanted();
+  // s is not exactly on the plane x+y+z=1 and m not exactly on the line ab.
+  EXPECT_NE(geom::Orient3d(c.plc.vertices[1], c.plc.vertices[2], c.plc.vertices[3],
+                           c.mesh.positions[5]),
+            0);
+  const ConformityReport r = CheckConformity(c.plc, c.mesh);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  EXPECT_NEAR(r.enclosed_volume, 1.0 / 6, 1e-15);
+  ConformityOptions exact;
+  exact.tolerance_ulps = 0;
+  const ConformityReport r0 = CheckConformity(c.plc, c.mesh, exact);
+  EXPECT_GT(r0.Count(ConformityCategory::kConformity), 0u) << r0.Summary();
+}
+
+TEST(Conformity, RejectsFlippedTet) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(p, 2);
+  std::swap(m.tets[5][2], m.tets[5][3]);
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kFlippedTet), 1u) << r.Summary();
+  EXPECT_GE(r.Count(ConformityCategory::kValidity), 1u);
+  ASSERT_FALSE(r.violations.empty());
+  const auto it = std::find_if(r.violations.begin(), r.violations.end(), [](const Violation& v) {
+    return v.kind == ViolationKind::kFlippedTet;
+  });
+  ASSERT_NE(it, r.violations.end());
+  EXPECT_EQ(it->ids, (std::vector<int64_t>{5}));
+}
+
+// Index of the first Kuhn tet of cell (i, j, k) of KuhnBoxMesh(p, n).
+size_t CellTet(int n, int i, int j, int k) { return static_cast<size_t>(((k * n + j) * n + i) * 6); }
+
+TEST(Conformity, RejectsDeletedTet) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(p, 3);
+  // A tet of the centre cell: all its faces are interior faces.
+  m.tets.erase(m.tets.begin() + CellTet(3, 1, 1, 1) + 2);
+  m.tet_region.pop_back();
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ConformityCategory::kValidity), 0u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kOpenFace), 4u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 1u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kConformity), 0u) << r.Summary();
+}
+
+TEST(Conformity, RejectsDeletedOnlyTet) {
+  // The corner tetrahedron as one tet: all faces lie on facets, so only the
+  // volume (and the triangles that lost their tet) show the loss.
+  SlantedCase c = Slanted();
+  plc::Plc& p = c.plc;
+  TetMesh m;
+  m.positions = p.vertices;
+  m.tets = {{0, 1, 2, 3}};
+  FixOrientation(&m);
+  m.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {1, 2, 3}};
+  m.triangle_marker = {1, 2, 3, 4};
+  ASSERT_TRUE(CheckConformity(p, m).ok()) << CheckConformity(p, m).Summary();
+  m.tets.clear();
+  m.tet_region.clear();
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 1u) << r.Summary();
+}
+
+TEST(Conformity, RejectsVertexMovedOffItsFacet) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  for (double delta : {1e-3, 1e-12}) {
+    TetMesh m = KuhnBoxMesh(p, 2);
+    // The Steiner point in the middle of the top facet.
+    auto it = std::find(m.positions.begin(), m.positions.end(), Vec3(0.5, 0.5, 1));
+    ASSERT_NE(it, m.positions.end());
+    it->z -= delta;
+    const ConformityReport r = CheckConformity(p, m);
+    EXPECT_EQ(r.Count(ConformityCategory::kValidity), 0u) << r.Summary();
+    EXPECT_GT(r.Count(ViolationKind::kTriangleOffFacet), 0u) << delta << "\n" << r.Summary();
+    EXPECT_EQ(r.Count(ViolationKind::kFacetNotCovered), 1u) << delta << "\n" << r.Summary();
+  }
+}
+
+TEST(Conformity, RejectsBrokenSegmentChain) {
+  // A cube with a free segment along the main diagonal 0-7: the Kuhn meshes
+  // contain it (through the centre for n = 2); the 5-tet cube does not.
+  plc::Plc p = BoxPlc(kLo, kHi);
+  p.segments.push_back({0, 7, 9});
+  for (int n : {1, 2}) {
+    const ConformityReport r = CheckConformity(p, KuhnBoxMesh(p, n));
+    EXPECT_TRUE(r.ok()) << n << "\n" << r.Summary();
+    EXPECT_EQ(r.num_segments_checked, 13u);
+  }
+  TetMesh five;
+  five.positions = p.vertices;
+  five.num_input_vertices = 8;
+  five.tets = {{1, 2, 4, 7}, {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}};
+  FixOrientation(&five);
+  // Boundary triangles of the 5-tet cube: each face split along the other diagonal.
+  testing::AssignBoxTriangles(p, &five);
+  ASSERT_EQ(five.triangles.size(), 12u);
+  const ConformityReport r = CheckConformity(p, five);
+  EXPECT_EQ(r.Count(ViolationKind::kBrokenSegment), 1u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kConformity), 1u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kValidity) + r.Count(ConformityCategory::kCoverage), 0u)
+      << r.Summary();
+  ASSERT_EQ(r.violations.size(), 1u);
+  EXPECT_EQ(r.violations[0].ids[0], 0);  // free segments come first
+}
+
+TEST(Conformity, RejectsOverlappingTetsWithUnchangedVolume) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(p, 3);
+  const double before = TotalVolume(m);
+  // In the centre cell, replace a Kuhn tet (volume 1/6 of the cell) by the
+  // cell's corner tet at its low corner (also 1/6), which overlaps the
+  // cell's remaining Kuhn tets.
+  const size_t t = CellTet(3, 1, 1, 1);
+  const uint32_t o = m.tets[t][0];  // every Kuhn tet of the cell starts at its low corner
+  auto vertex_at = [&](Vec3 q) {
+    return static_cast<uint32_t>(std::find(m.positions.begin(), m.positions.end(), q) -
+                                 m.positions.begin());
+  };
+  const Vec3 c = m.positions[o];
+  const double h = 1.0 / 3;
+  m.tets[t + 1] = {o, vertex_at(Vec3(c.x + h, c.y, c.z)), vertex_at(Vec3(c.x, c.y + h, c.z)),
+                   vertex_at(Vec3(c.x, c.y, c.z + h))};
+  FixOrientation(&m);
+  EXPECT_NEAR(TotalVolume(m), before, 1e-15);
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 0u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kConformity), 0u) << r.Summary();
+  EXPECT_GT(r.Count(ViolationKind::kOpenFace), 0u) << r.Summary();
+}
+
+TEST(Conformity, RejectsDroppedFacetTriangle) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(p, 2);
+  const int32_t marker = m.triangle_marker[3];
+  m.triangles.erase(m.triangles.begin() + 3);
+  m.triangle_marker.erase(m.triangle_marker.begin() + 3);
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kFacetNotCovered), 1u) << r.Summary();
+  EXPECT_EQ(r.violations.size(), 1u) << r.Summary();
+  EXPECT_EQ(r.violations[0].ids[0], marker - 1);  // facet index = marker - 1
+}
+
+TEST(Conformity, RejectsTetsCrossingAFacetAndMissingVertices) {
+  const plc::Plc split = BoxPlc(kLo, kHi, /*split=*/true);
+  const plc::Plc whole = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(whole, 1);  // knows nothing of the facet x = 0.5
+  ConformityOptions opt;
+  const ConformityReport r = CheckConformity(split, m, opt);
+  EXPECT_GT(r.Count(ViolationKind::kTetCrossesFacet), 0u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kMissingInputVertex), 4u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kFacetNotCovered), 1u) << r.Summary();
+  // A Kuhn mesh with n = 3 has vertices at x = 1/3, 2/3 only: also crossing.
+  const ConformityReport r3 = CheckConformity(split, KuhnBoxMesh(whole, 3), opt);
+  EXPECT_GT(r3.Count(ViolationKind::kTetCrossesFacet), 0u) << r3.Summary();
+}
+
+TEST(Conformity, RejectsWrongMarkerDuplicatesAndBadIds) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  {
+    TetMesh m = KuhnBoxMesh(p, 2);
+    m.triangle_marker[0] = 42;
+    const ConformityReport r = CheckConformity(p, m);
+    EXPECT_EQ(r.Count(ViolationKind::kWrongMarker), 1u) << r.Summary();
+    EXPECT_EQ(r.violations.size(), 1u);
+  }
+  {
+    TetMesh m = KuhnBoxMesh(p, 2);
+    m.tets.push_back({m.tets[7][1], m.tets[7][0], m.tets[7][3], m.tets[7][2]});
+    m.tet_region.push_back(0);
+    const ConformityReport r = CheckValidity(m);
+    EXPECT_EQ(r.Count(ViolationKind::kDuplicateTet), 1u) << r.Summary();
+    EXPECT_GT(r.Count(ViolationKind::kFaceInMoreThanTwoTets), 0u);
+  }
+  {
+    TetMesh m = KuhnBoxMesh(p, 2);
+    m.tets[2][1] = static_cast<uint32_t>(m.positions.size());
+    m.triangles.push_back({0, 1, 99});
+    m.triangle_marker.push_back(1);
+    m.tet_region.pop_back();
+    const ConformityReport r = CheckConformity(p, m);
+    EXPECT_EQ(r.Count(ViolationKind::kIdOutOfRange), 2u) << r.Summary();
+    EXPECT_EQ(r.Count(ViolationKind::kTagCountMismatch), 1u) << r.Summary();
+  }
+  {
+    TetMesh m = KuhnBoxMesh(p, 2);
+    m.triangles.push_back({0, 1, 99 % 8});
+    m.triangle_marker.push_back(5);
+    const ConformityReport r = CheckValidity(m);
+    EXPECT_GE(r.Count(ViolationKind::kTriangleNotAFace), 1u) << r.Summary();
+  }
+}
+
+TEST(Conformity, RejectsSameSideNeighbours) {
+  // Two tets on the same side of their shared face: a positive tet and a
+  // smaller positive tet inside it sharing the face.
+  TetMesh m;
+  m.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
+                 Vec3(0.1, 0.1, 0.1)};
+  m.tets = {{0, 1, 2, 3}, {0, 1, 2, 4}};
+  FixOrientation(&m);
+  const ConformityReport r = CheckValidity(m);
+  EXPECT_EQ(r.Count(ViolationKind::kNeighborsSameSide), 1u) << r.Summary();
+}
+
+TEST(Conformity, CanonicalIndexRequirement) {
+  const plc::Plc p = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(p, 2);
+  // Swap vertices 0 and 20 (ids in tets and triangles follow).
+  std::swap(m.positions[0], m.positions[20]);
+  for (auto& t : m.tets) {
+    for (auto& v : t) v = v == 0 ? 20 : (v == 20 ? 0 : v);
+  }
+  for (auto& t : m.triangles) {
+    for (auto& v : t) v = v == 0 ? 20 : (v == 20 ? 0 : v);
+  }
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kInputVertexIndex), 1u) << r.Summary();
+  EXPECT_EQ(r.violations.size(), 1u) << r.Summary();
+  ConformityOptions by_coordinates;
+  by_coordinates.input_vertices_first = false;
+  EXPECT_TRUE(CheckConformity(p, m, by_coordinates).ok());
+}
+
+TEST(Conformity, ScalesToHundredsOfThousandsOfTets) {
+  const plc::Plc p = BoxPlc(kLo, kHi, /*split=*/true);
+  const TetMesh m = KuhnBoxMesh(p, 24);  // 82,944 tets
+  const auto t0 = std::chrono::steady_clock::now();
+  const ConformityReport r = CheckConformity(p, m);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  EXPECT_EQ(m.tets.size(), 82944u);
+  RecordProperty("seconds", std::to_string(s));
+  std::printf("checked %zu tets in %.3f s\n", m.tets.size(), s);
+}
+
+}  // namespace
+}  // namespace svrc::mesh
