@@ -1,0 +1,107 @@
+// The job service without gRPC: a table of jobs, the queue, the workers that
+// run core::MeshPlc, progress fanned out to watchers, cancellation through
+// core::CancelToken, deadlines, retention. service.cc adapts it to gRPC;
+// tests drive it directly. DESIGN.md "Data flow".
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/container/flat_hash_map.h"
+#include "absl/random/random.h"
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "core/api.h"
+#include "server/job_queue.h"
+#include "server/result_store.h"
+#include "server/worker_pool.h"
+#include "svrc/v1/service.pb.h"
+
+namespace svrc::server {
+
+struct JobManagerOptions {
+  int workers = 2;
+  // Longest input accepted (bytes of the file or the serialized PLC).
+  uint64_t max_input_bytes = uint64_t{2} << 30;
+  // Progress events reach watchers at most this often (state changes always).
+  absl::Duration progress_interval = absl::Milliseconds(100);
+  // Finished jobs and their results are forgotten this long after they end.
+  absl::Duration retention = absl::Hours(24);
+  // How often queued deadlines and retention are checked.
+  absl::Duration janitor_interval = absl::Milliseconds(200);
+};
+
+class JobManager {
+ public:
+  // Called with every change of a job, under the manager's lock: it must not
+  // block or call back into the manager.
+  using Listener = std::function<void(const v1::JobEvent& event)>;
+
+  JobManager(JobManagerOptions options, std::unique_ptr<JobQueue> queue,
+             std::unique_ptr<ResultStore> store);
+  // Calls Shutdown(zero) if it was not called.
+  ~JobManager();
+
+  // Validates the request shape and parameters, then queues the job. The
+  // input is moved out of `request`. Same request_id as an earlier job: that
+  // job. RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE when draining.
+  absl::StatusOr<v1::Job> Submit(v1::SubmitJobRequest request);
+  absl::StatusOr<v1::Job> Get(const std::string& job_id);
+  absl::StatusOr<v1::ListJobsResponse> List(const v1::ListJobsRequest& request);
+  absl::StatusOr<v1::Job> Cancel(const std::string& job_id);
+  absl::Status Delete(const std::string& job_id);
+
+  // Calls `listener` at once with the current state, then on every change
+  // until Unsubscribe. Returns the subscription token.
+  absl::StatusOr<uint64_t> Subscribe(const std::string& job_id, Listener listener);
+  void Unsubscribe(const std::string& job_id, uint64_t token);
+
+  // The stored result of a SUCCEEDED job (FAILED_PRECONDITION otherwise).
+  absl::StatusOr<StoredResult> Result(const std::string& job_id);
+  ResultStore* store() { return store_.get(); }
+
+  // Stops accepting jobs, cancels the queued ones, lets running jobs finish
+  // for up to `grace`, then cancels them and joins the workers.
+  void Shutdown(absl::Duration grace);
+  bool accepting() const;
+  int running() const;
+
+ private:
+  struct JobRecord;
+
+  void RunJob(const std::string& job_id);
+  absl::Status Execute(JobRecord* rec, const v1::SubmitJobRequest& request,
+                       StoredResult* stored, v1::ResultInfo* info);
+  // Moves a job to a terminal state from `status` and notifies.
+  void Finish(JobRecord* rec, const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void Notify(JobRecord* rec) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void OnProgress(JobRecord* rec, const core::Progress& progress);
+  void JanitorLoop();
+
+  const JobManagerOptions options_;
+  std::unique_ptr<JobQueue> queue_;
+  std::unique_ptr<ResultStore> store_;
+
+  mutable absl::Mutex mu_;
+  absl::flat_hash_map<std::string, std::unique_ptr<JobRecord>> jobs_ ABSL_GUARDED_BY(mu_);
+  std::map<uint64_t, std::string> order_ ABSL_GUARDED_BY(mu_);  // submission seq -> id
+  absl::flat_hash_map<std::string, std::string> by_request_id_ ABSL_GUARDED_BY(mu_);
+  absl::BitGen bitgen_ ABSL_GUARDED_BY(mu_);
+  uint64_t next_seq_ ABSL_GUARDED_BY(mu_) = 1;
+  uint64_t next_token_ ABSL_GUARDED_BY(mu_) = 1;
+  int running_ ABSL_GUARDED_BY(mu_) = 0;
+  bool accepting_ ABSL_GUARDED_BY(mu_) = true;
+  bool stopped_ ABSL_GUARDED_BY(mu_) = false;
+
+  std::unique_ptr<WorkerPool> workers_;
+  std::thread janitor_;
+};
+
+}  // namespace svrc::server

@@ -1,0 +1,300 @@
+#include "server/service.h"
+
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/strings/str_cat.h"
+#include "absl/synchronization/mutex.h"
+#include "proto/convert.h"
+#include "server/log.h"
+#include "server/status_util.h"
+
+namespace svrc::server {
+namespace {
+
+// Finishes a unary call with the outcome of `result` copied into `response`.
+template <typename T>
+grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context,
+                                      absl::StatusOr<T> result, T* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (result.ok()) *response = std::move(*result);
+  reactor->Finish(ToGrpcStatus(result.status()));
+  return reactor;
+}
+
+// UploadJob: a header message, then chunks appended to the file; submitted
+// when the client half-closes.
+class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest> {
+ public:
+  UploadReactor(JobManager* manager, uint64_t max_bytes, v1::Job* response)
+      : manager_(manager), max_bytes_(max_bytes), response_(response) {
+    StartRead(&message_);
+  }
+
+  void OnReadDone(bool ok) override {
+    if (!ok) {  // the client finished sending (or the call broke: then OnDone follows)
+      Submit();
+      return;
+    }
+    if (!have_header_) {
+      if (message_.part_case() != v1::UploadJobRequest::kHeader ||
+          message_.header().input_case() != v1::SubmitJobRequest::kFile) {
+        Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                            "the first UploadJob message must be a header with an input file"));
+        return;
+      }
+      request_ = std::move(*message_.mutable_header());
+      have_header_ = true;
+    } else {
+      if (message_.part_case() != v1::UploadJobRequest::kChunk) {
+        Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                            "only data chunks may follow the UploadJob header"));
+        return;
+      }
+      std::string* data = request_.mutable_file()->mutable_data();
+      if (data->size() + message_.chunk().size() > max_bytes_) {
+        Finish(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                            absl::StrCat("upload exceeds the server's limit of ", max_bytes_,
+                                         " bytes")));
+        return;
+      }
+      data->append(message_.chunk());
+    }
+    message_.Clear();
+    StartRead(&message_);
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  void Submit() {
+    if (!have_header_) {
+      Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "empty upload: no header"));
+      return;
+    }
+    absl::StatusOr<v1::Job> job = manager_->Submit(std::move(request_));
+    if (job.ok()) *response_ = std::move(*job);
+    Finish(ToGrpcStatus(job.status()));
+  }
+
+  JobManager* manager_;
+  const uint64_t max_bytes_;
+  v1::Job* response_;
+  v1::UploadJobRequest message_;
+  v1::SubmitJobRequest request_;
+  bool have_header_ = false;
+};
+
+// WatchJob: the manager calls Push() with every snapshot of the job (under
+// its lock, so Push never blocks). One write is in flight at a time; newer
+// snapshots replace an unsent one, since each carries the whole job.
+class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
+ public:
+  WatchReactor(JobManager* manager, const std::string& job_id)
+      : manager_(manager), job_id_(job_id) {
+    absl::StatusOr<uint64_t> token =
+        manager_->Subscribe(job_id_, [this](const v1::JobEvent& e) { Push(e); });
+    if (!token.ok()) {
+      Finish(ToGrpcStatus(token.status()));
+      return;
+    }
+    absl::MutexLock lock(&mu_);
+    token_ = *token;
+  }
+
+  void OnWriteDone(bool ok) override {
+    if (!ok) return;  // the stream broke: OnDone follows
+    bool finish = false;
+    {
+      absl::MutexLock lock(&mu_);
+      writing_ = false;
+      if (pending_) {
+        in_flight_ = std::move(*pending_);
+        pending_.reset();
+        writing_ = true;
+      } else if (sent_terminal_) {
+        finish = !finished_;
+        finished_ = true;
+      }
+    }
+    if (finish) {
+      Finish(grpc::Status::OK);
+    } else {
+      MaybeWrite();
+    }
+  }
+
+  void OnCancel() override {
+    bool finish = false;
+    {
+      absl::MutexLock lock(&mu_);
+      finish = !finished_;
+      finished_ = true;
+    }
+    if (finish) Finish(grpc::Status::CANCELLED);
+  }
+
+  void OnDone() override {
+    uint64_t token;
+    {
+      absl::MutexLock lock(&mu_);
+      token = token_;
+    }
+    if (token != 0) manager_->Unsubscribe(job_id_, token);
+    delete this;
+  }
+
+ private:
+  void Push(const v1::JobEvent& event) {
+    {
+      absl::MutexLock lock(&mu_);
+      if (finished_ || sent_terminal_) return;
+      if (writing_) {
+        pending_ = event;
+        if (api::IsTerminal(event.job().state())) sent_terminal_ = true;
+        return;
+      }
+      in_flight_ = event;
+      writing_ = true;
+      if (api::IsTerminal(event.job().state())) sent_terminal_ = true;
+    }
+    StartWrite(&in_flight_);
+  }
+
+  void MaybeWrite() {
+    {
+      absl::MutexLock lock(&mu_);
+      if (!writing_) return;
+    }
+    StartWrite(&in_flight_);
+  }
+
+  JobManager* manager_;
+  const std::string job_id_;
+  absl::Mutex mu_;
+  uint64_t token_ ABSL_GUARDED_BY(mu_) = 0;
+  v1::JobEvent in_flight_;  // owned by gRPC while writing_
+  std::optional<v1::JobEvent> pending_ ABSL_GUARDED_BY(mu_);
+  bool writing_ ABSL_GUARDED_BY(mu_) = false;
+  bool sent_terminal_ ABSL_GUARDED_BY(mu_) = false;  // the last event queued is terminal
+  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+// FetchResult: chunks read from the result store one at a time (a read of
+// <= 1 MiB from the local disk; an object-store implementation would read
+// ahead on its own thread).
+class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
+ public:
+  FetchReactor(JobManager* manager, const v1::FetchResultRequest& request)
+      : manager_(manager), job_id_(request.job_id()), offset_(request.offset()) {
+    chunk_bytes_ = request.max_chunk_bytes() == 0 ||
+                           request.max_chunk_bytes() > MeshingServiceImpl::kMaxChunkBytes
+                       ? MeshingServiceImpl::kMaxChunkBytes
+                       : request.max_chunk_bytes();
+    absl::StatusOr<StoredResult> stored = manager_->Result(job_id_);
+    if (!stored.ok()) {
+      Finish(ToGrpcStatus(stored.status()));
+      return;
+    }
+    if (offset_ > stored->size) {
+      Finish(grpc::Status(grpc::StatusCode::OUT_OF_RANGE,
+                          absl::StrCat("offset ", offset_, " is past the end of the result (",
+                                       stored->size, " bytes)")));
+      return;
+    }
+    total_ = stored->size;
+    sha256_ = stored->sha256;
+    NextChunk();
+  }
+
+  void OnWriteDone(bool ok) override {
+    if (!ok) return;
+    NextChunk();
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  void NextChunk() {
+    if (offset_ >= total_ && sent_any_) {
+      Finish(grpc::Status::OK);
+      return;
+    }
+    absl::StatusOr<std::string> data = manager_->store()->Read(job_id_, offset_, chunk_bytes_);
+    if (!data.ok()) {
+      Finish(ToGrpcStatus(data.status()));
+      return;
+    }
+    chunk_.Clear();
+    chunk_.set_offset(offset_);
+    chunk_.set_total_size(total_);
+    chunk_.set_sha256(sha256_);
+    offset_ += data->size();
+    *chunk_.mutable_data() = std::move(*data);
+    sent_any_ = true;
+    StartWrite(&chunk_);
+  }
+
+  JobManager* manager_;
+  const std::string job_id_;
+  uint64_t offset_;
+  uint64_t chunk_bytes_;
+  uint64_t total_ = 0;
+  std::string sha256_;
+  bool sent_any_ = false;
+  v1::ResultChunk chunk_;
+};
+
+}  // namespace
+
+grpc::ServerUnaryReactor* MeshingServiceImpl::SubmitJob(grpc::CallbackServerContext* context,
+                                                        const v1::SubmitJobRequest* request,
+                                                        v1::Job* response) {
+  // One copy of the (<= 4 MiB) request; the manager owns it from here.
+  return FinishUnary(context, manager_->Submit(*request), response);
+}
+
+grpc::ServerReadReactor<v1::UploadJobRequest>* MeshingServiceImpl::UploadJob(
+    grpc::CallbackServerContext* context, v1::Job* response) {
+  return new UploadReactor(manager_, max_upload_bytes_, response);
+}
+
+grpc::ServerWriteReactor<v1::JobEvent>* MeshingServiceImpl::WatchJob(
+    grpc::CallbackServerContext* context, const v1::WatchJobRequest* request) {
+  return new WatchReactor(manager_, request->job_id());
+}
+
+grpc::ServerUnaryReactor* MeshingServiceImpl::GetJob(grpc::CallbackServerContext* context,
+                                                     const v1::GetJobRequest* request,
+                                                     v1::Job* response) {
+  return FinishUnary(context, manager_->Get(request->job_id()), response);
+}
+
+grpc::ServerUnaryReactor* MeshingServiceImpl::ListJobs(grpc::CallbackServerContext* context,
+                                                       const v1::ListJobsRequest* request,
+                                                       v1::ListJobsResponse* response) {
+  return FinishUnary(context, manager_->List(*request), response);
+}
+
+grpc::ServerUnaryReactor* MeshingServiceImpl::CancelJob(grpc::CallbackServerContext* context,
+                                                        const v1::CancelJobRequest* request,
+                                                        v1::Job* response) {
+  return FinishUnary(context, manager_->Cancel(request->job_id()), response);
+}
+
+grpc::ServerUnaryReactor* MeshingServiceImpl::DeleteJob(grpc::CallbackServerContext* context,
+                                                        const v1::DeleteJobRequest* request,
+                                                        v1::DeleteJobResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(ToGrpcStatus(manager_->Delete(request->job_id())));
+  return reactor;
+}
+
+grpc::ServerWriteReactor<v1::ResultChunk>* MeshingServiceImpl::FetchResult(
+    grpc::CallbackServerContext* context, const v1::FetchResultRequest* request) {
+  return new FetchReactor(manager_, *request);
+}
+
+}  // namespace svrc::server
