@@ -25,6 +25,16 @@ constexpr uint32_t kInf = kInfiniteVertex.value();
 // Face f of a tet consists of the vertices at kFaceVertices[f][0..2].
 constexpr int kFaceVertices[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
 
+// kEdge[a][i]: for a tet whose apex (the vertex shared by all new tets) is at
+// position a, the face opposite position i != a contains the apex and the
+// edge between positions kEdge[a][i][0] and kEdge[a][i][1].
+constexpr uint8_t kEdge[4][4][2] = {
+    {{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+    {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+    {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+    {{1, 2}, {0, 2}, {0, 1}, {0, 0}},
+};
+
 inline uint64_t EdgeKey(uint32_t a, uint32_t b) {
   return a < b ? (static_cast<uint64_t>(a) << 32) | b : (static_cast<uint64_t>(b) << 32) | a;
 }
@@ -59,7 +69,7 @@ void Delaunay3::Reserve(size_t num_vertices) {
 // ---------------------------------------------------------------------------
 // Tet slots.
 
-uint32_t Delaunay3::NewTet() {
+inline uint32_t Delaunay3::NewTet() {
   uint32_t t;
   if (free_head_ != kFreeSlot) {
     t = free_head_;
@@ -75,7 +85,7 @@ uint32_t Delaunay3::NewTet() {
   return t;
 }
 
-void Delaunay3::FreeTet(uint32_t t) {
+inline void Delaunay3::FreeTet(uint32_t t) {
   if (tet_v_[4 * t + 3] == kInf) --num_ghost_tets_;
   tet_v_[4 * t] = kFreeSlot;
   tet_n_[4 * t] = free_head_;
@@ -101,21 +111,30 @@ uint32_t Delaunay3::FreshStamps(uint32_t n) const {
 
 // Conflict of tet t with p. Sets *sos_used when the decision needed the
 // symbolic perturbation (an exactly cospherical / coplanar configuration).
-bool Delaunay3::ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const {
+inline bool Delaunay3::ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid,
+                                   uint32_t* sos_used) const {
   const uint32_t* v = &tet_v_[4 * t];
   if (v[3] != kInf) {
     const int s = geom::InSphere(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p);
     if (s != 0) return s > 0;
+  }
+  return ConflictSlow(t, p, gid, sos_used);
+}
+
+bool Delaunay3::ConflictSlow(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const {
+  const uint32_t* v = &tet_v_[4 * t];
+  if (v[3] != kInf) {
+    // The exact in-sphere value is 0 (ConflictRaw ran it).
     *sos_used = 1;
-    return geom::internal::InSphereSoSTail(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p,
-                             global_ids_[v[0]], global_ids_[v[1]], global_ids_[v[2]],
-                             global_ids_[v[3]], gid) > 0;
+    return geom::internal::InSphereSoSTail(points_[v[0]], points_[v[1]], points_[v[2]],
+                                           points_[v[3]], p, global_ids_[v[0]], global_ids_[v[1]],
+                                           global_ids_[v[2]], global_ids_[v[3]], gid) > 0;
   }
   // Ghost (a,b,c,∞): conflict iff p is strictly beyond the hull face, or on
   // its plane and inside its circumcircle. The perturbed in-circle test equals
   // the perturbed in-sphere test of the finite tet behind the face: the sphere
-  // meets the plane in the face's circumcircle, and under lifted perturbation
-  // the opposite vertex's term has coefficient Orient3d(a,b,c,p) = 0.
+  // meets the plane in the face's circumcircle, and under the lifting
+  // perturbation the opposite vertex's term has coefficient Orient3d(a,b,c,p) = 0.
   const int o = geom::Orient3d(points_[v[0]], points_[v[1]], points_[v[2]], p);
   if (o != 0) return o > 0;
   return ConflictRaw(tet_n_[4 * t + 3] >> 2, p, gid, sos_used);
@@ -142,12 +161,22 @@ uint32_t Delaunay3::WalkRaw(const Vec3& p, uint32_t t, uint32_t* steps) const {
     rng ^= rng << 5;
     const uint32_t r = rng & 3;
     bool moved = false;
+    const Vec3& a = points_[v[0]];
+    const Vec3& b = points_[v[1]];
+    const Vec3& c = points_[v[2]];
+    const Vec3& d = points_[v[3]];
     for (uint32_t k = 0; k < 4; ++k) {
       const uint32_t f = (r + k) & 3;
       if (f == from) continue;
-      Vec3 q[4] = {points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]};
-      q[f] = p;
-      if (geom::Orient3d(q[0], q[1], q[2], q[3]) < 0) {
+      // Orientation with vertex f replaced by p: < 0 iff p is beyond face f.
+      int o;
+      switch (f) {
+        case 0: o = geom::Orient3d(p, b, c, d); break;
+        case 1: o = geom::Orient3d(a, p, c, d); break;
+        case 2: o = geom::Orient3d(a, b, p, d); break;
+        default: o = geom::Orient3d(a, b, c, p); break;
+      }
+      if (o < 0) {
         const uint32_t n = tet_n_[4 * t + f];
         t = n >> 2;
         from = n & 3;
@@ -276,43 +305,70 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
   const size_t nb = boundary_.size();
   new_v_.resize(4 * nb);
   new_outer_.resize(nb);
-  new_face_.resize(nb);
   for (size_t k = 0; k < nb; ++k) {
-    const uint32_t b = boundary_[k];
-    const uint32_t t = b >> 2, f = b & 3;
-    for (int i = 0; i < 4; ++i) new_v_[4 * k + i] = tet_v_[4 * t + i];
-    new_v_[4 * k + f] = v;
-    new_outer_[k] = tet_n_[b];
-    new_face_[k] = static_cast<uint8_t>(f);
+    const uint32_t bf = boundary_[k];
+    const uint32_t t = bf >> 2;
+    std::copy_n(&tet_v_[4 * t], 4, &new_v_[4 * k]);
+    new_v_[4 * k + (bf & 3)] = v;
+    new_outer_[k] = tet_n_[bf];
   }
   for (TetId dt : destroyed_) FreeTet(dt.value());
 
-  created_.clear();
+  // Create them and glue them: the face opposite position i != f of new tet k
+  // goes through p and the edge kEdge[f][i] of the boundary face; the other
+  // new tet on that edge is found in a stamped hash table.
+  const uint32_t mask = EdgeTableFor(nb);
+  EdgeSlot* table = edge_table_.data();
+  const uint32_t epoch = edge_epoch_;
+  created_.resize(nb);
   for (size_t k = 0; k < nb; ++k) {
     const uint32_t t = NewTet();
+    created_[k] = TetId(t);
     uint32_t* tv = &tet_v_[4 * t];
-    for (int i = 0; i < 4; ++i) tv[i] = new_v_[4 * k + i];
+    std::copy_n(&new_v_[4 * k], 4, tv);
     if (tv[3] == kInf) ++num_ghost_tets_;
-    const uint32_t f = new_face_[k];
+    const uint32_t f = boundary_[k] & 3;
     const uint32_t o = new_outer_[k];
     tet_n_[4 * t + f] = o;
     tet_n_[o] = 4 * t + f;
     tet_mark_[t] = 0;
-    created_.push_back(TetId(t));
-  }
-  LinkAroundApex(v);
-
-  // Vertex → tet and the cavity's vertices.
-  ++vertex_stamp_;
-  if (vertex_mark_.size() < points_.size()) vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
-  cavity_vertices_.clear();
-  for (TetId ct : created_) {
-    const uint32_t t = ct.value();
+    for (uint32_t i = 0; i < 4; ++i) {
+      if (i == f) continue;
+      const uint64_t key = EdgeKey(tv[kEdge[f][i][0]], tv[kEdge[f][i][1]]);
+      uint32_t h = HashKey(key) & mask;
+      for (;;) {
+        EdgeSlot& e = table[h];
+        if (e.stamp != epoch) {
+          e.stamp = epoch;
+          e.key = key;
+          e.val = 4 * t + i;
+          break;
+        }
+        if (e.key == key) {
+          tet_n_[4 * t + i] = e.val;
+          tet_n_[e.val] = 4 * t + i;
+          break;
+        }
+        h = (h + 1) & mask;
+      }
+    }
+    // Vertex → tet for p and the boundary face's vertices.
     for (int i = 0; i < 4; ++i) {
-      const uint32_t w = tet_v_[4 * t + i];
-      if (w == kInf) continue;
-      vertex_tet_[w] = t;
-      if (w != v && vertex_mark_[w] != vertex_stamp_) {
+      if (tv[i] != kInf) vertex_tet_[tv[i]] = t;
+    }
+  }
+
+  cavity_vertices_.clear();
+  if (report_cavity_vertices_) {
+    ++vertex_stamp_;
+    if (vertex_mark_.size() < points_.size()) {
+      vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
+    }
+    for (TetId ct : created_) {
+      const uint32_t* tv = &tet_v_[4 * ct.value()];
+      for (int i = 0; i < 4; ++i) {
+        const uint32_t w = tv[i];
+        if (w == kInf || w == v || vertex_mark_[w] == vertex_stamp_) continue;
         vertex_mark_[w] = vertex_stamp_;
         cavity_vertices_.push_back(VertexId(w));
       }
@@ -338,21 +394,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
 // and the vertex opposite the face. Each such edge is shared by exactly two
 // created tets (the cavity boundary is a closed surface).
 void Delaunay3::LinkAroundApex(uint32_t apex) {
-  const size_t need = 4 * created_.size() * 3 / 2 + 16;
-  if (edge_keys_.size() < need) {
-    size_t sz = 64;
-    while (sz < 2 * need) sz *= 2;
-    edge_keys_.assign(sz, 0);
-    edge_vals_.assign(sz, 0);
-    edge_stamp_.assign(sz, 0);
-    edge_epoch_ = 0;
-  }
-  ++edge_epoch_;
-  if (edge_epoch_ == 0) {
-    std::fill(edge_stamp_.begin(), edge_stamp_.end(), 0);
-    edge_epoch_ = 1;
-  }
-  const uint32_t mask = static_cast<uint32_t>(edge_keys_.size() - 1);
+  const uint32_t mask = EdgeTableFor(created_.size());
   for (TetId ct : created_) {
     const uint32_t t = ct.value();
     const uint32_t* tv = &tet_v_[4 * t];
@@ -360,31 +402,40 @@ void Delaunay3::LinkAroundApex(uint32_t apex) {
     while (tv[a] != apex) ++a;
     for (int i = 0; i < 4; ++i) {
       if (i == a) continue;
-      // The face opposite i contains the apex and the edge {tv[j], tv[k]}.
-      uint32_t e[2];
-      int m = 0;
-      for (int j = 0; j < 4; ++j) {
-        if (j != i && j != a) e[m++] = tv[j];
-      }
-      const uint64_t key = EdgeKey(e[0], e[1]);
+      const uint64_t key = EdgeKey(tv[kEdge[a][i][0]], tv[kEdge[a][i][1]]);
       uint32_t h = HashKey(key) & mask;
       for (;;) {
-        if (edge_stamp_[h] != edge_epoch_) {
-          edge_stamp_[h] = edge_epoch_;
-          edge_keys_[h] = key;
-          edge_vals_[h] = 4 * t + i;
+        EdgeSlot& e = edge_table_[h];
+        if (e.stamp != edge_epoch_) {
+          e = {key, 4 * t + i, edge_epoch_};
           break;
         }
-        if (edge_keys_[h] == key) {
-          const uint32_t other = edge_vals_[h];
-          tet_n_[4 * t + i] = other;
-          tet_n_[other] = 4 * t + i;
+        if (e.key == key) {
+          tet_n_[4 * t + i] = e.val;
+          tet_n_[e.val] = 4 * t + i;
           break;
         }
         h = (h + 1) & mask;
       }
     }
   }
+}
+
+// Makes the edge table large enough for the edges of num_tets new tets (3/2
+// per tet, load <= 1/4) and starts a new epoch; returns the index mask.
+uint32_t Delaunay3::EdgeTableFor(size_t num_tets) {
+  const size_t need = 6 * num_tets + 16;
+  if (edge_table_.size() < need) {
+    size_t sz = 64;
+    while (sz < need) sz *= 2;
+    edge_table_.assign(sz, EdgeSlot{0, 0, 0});
+    edge_epoch_ = 0;
+  }
+  if (++edge_epoch_ == 0) {
+    for (auto& e : edge_table_) e.stamp = 0;
+    edge_epoch_ = 1;
+  }
+  return static_cast<uint32_t>(edge_table_.size() - 1);
 }
 
 // Before the first tetrahedron: keep points, track the affine hull of the

@@ -91,6 +91,10 @@ class Delaunay3 {
   // Pre-allocates for about `num_vertices` vertices (tets ≈ 6.7 per vertex).
   void Reserve(size_t num_vertices);
 
+  // Whether Insert fills InsertResult::cavity_vertices (default true). A
+  // batch build that does not need them turns this off to save time.
+  void set_report_cavity_vertices(bool on) { report_cavity_vertices_ = on; }
+
   // Inserts `p` with SoS priority `global_id`. `hint` is any live tet near p
   // (kNoneTet: the last created tet): if it conflicts with p the cavity grows
   // from it directly — SVRC's ForceInsert passes a known conflicting tet and
@@ -199,6 +203,7 @@ class Delaunay3 {
   void FreeTet(uint32_t t);
   uint32_t FreshStamps(uint32_t n) const;
   bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
+  bool ConflictSlow(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
   uint32_t WalkRaw(const Vec3& p, uint32_t start, uint32_t* steps) const;
   InsertResult InsertPending(const Vec3& p, uint32_t global_id);
   void BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d);
@@ -231,13 +236,17 @@ class Delaunay3 {
   std::vector<uint32_t> stack_;
   std::vector<uint32_t> new_v_;      // per boundary face: the new tet's vertices
   std::vector<uint32_t> new_outer_;  // per boundary face: the outer neighbour 4t+f
-  std::vector<uint8_t> new_face_;    // per boundary face: its index in the new tet
-  std::vector<uint64_t> edge_keys_;  // stamped open-addressing table: edge → 4t+f
-  std::vector<uint32_t> edge_vals_;
-  std::vector<uint32_t> edge_stamp_;
+  struct EdgeSlot {
+    uint64_t key;
+    uint32_t val;
+    uint32_t stamp;
+  };
+  std::vector<EdgeSlot> edge_table_;  // stamped open addressing: edge → 4t+f
   uint32_t edge_epoch_ = 0;
+  uint32_t EdgeTableFor(size_t num_tets);
   mutable std::vector<uint32_t> vertex_mark_;
   mutable uint32_t vertex_stamp_ = 0;
+  bool report_cavity_vertices_ = true;
   Stats stats_;
 };
 

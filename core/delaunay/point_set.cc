@@ -130,6 +130,7 @@ absl::StatusOr<PointSetResult> TetrahedralizePointSet(std::span<const geom::Vec3
   t0 = std::chrono::steady_clock::now();
   Delaunay3 dt;
   dt.Reserve(m);
+  dt.set_report_cavity_vertices(false);
   const uint32_t poll = std::max<uint32_t>(options.poll_interval, 1);
   for (size_t i = 0; i < m; ++i) {
     const uint32_t id = ins[i];
