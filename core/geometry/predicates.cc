@@ -7,6 +7,8 @@
 #include <cmath>
 #include <initializer_list>
 
+#include <gmpxx.h>
+
 #include "core/geometry/expansion.h"
 
 namespace svrc::geom {
@@ -22,112 +24,179 @@ using internal::SignOf;
 void CountExact(Pred p) { ++internal::tls_predicate_stats.exact[static_cast<int>(p)]; }
 void CountSos(Pred p) { ++internal::tls_predicate_stats.sos[static_cast<int>(p)]; }
 
-// ---------------------------------------------------------------- rescaling
-// Every predicate is a homogeneous polynomial in the coordinates (or in their
-// differences), so multiplying all inputs by 2^k (exact, barring underflow of
-// the scaled values) keeps its sign. Before exact evaluation we scale so that
-// the largest |coordinate| is about 2^(960/degree): products of `degree`
-// factors (and the sums of a few dozen of them) stay below 2^996, where
-// Dekker's split would overflow, while tiny differences (down to denormal
-// nudges of a zero coordinate) are lifted as far from the underflow threshold
-// as possible. Exact as long as no product of nonzero differences falls below
-// ~2^-969 after scaling, i.e. unless the input's nonzero coordinate differences
-// span more than ~2^(1900/degree) (pathological; documented in predicates.h).
-int TargetExponent(int degree) { return 960 / degree - 8; }
+// ---------------------------------------------------------- number types
+// The exact polynomials are written once as templates over the number type:
+// Expansion (fast, the normal exact path) and mpq_class (GMP; only when the
+// input's exponent range is too wide for expansions, see PlanScaling).
 
-class Scaler {
- public:
-  Scaler(std::initializer_list<double> values, int degree) {
-    double m = 0;
-    for (double v : values) m = std::max(m, std::fabs(v));
-    if (m != 0 && std::isfinite(m)) k_ = TargetExponent(degree) - std::ilogb(m);
-  }
-  double operator()(double x) const { return k_ == 0 ? x : std::ldexp(x, k_); }
-  Vec2 operator()(Vec2 p) const { return {(*this)(p.x), (*this)(p.y)}; }
-  Vec3 operator()(const Vec3& p) const { return {(*this)(p.x), (*this)(p.y), (*this)(p.z)}; }
+template <class T>
+T Cv(double x);
+template <>
+Expansion Cv<Expansion>(double x) {
+  return Expansion(x);
+}
+template <>
+mpq_class Cv<mpq_class>(double x) {
+  return mpq_class(x);
+}
+int SignOfT(const Expansion& e) { return e.Sign(); }
+int SignOfT(const mpq_class& q) { return sgn(q); }
 
- private:
-  int k_ = 0;
-};
-
-// ------------------------------------------------------ exact core predicates
-// The same formulas as the inline filters, on exact differences.
-
-int Orient2dExactImpl(Vec2 a, Vec2 b, Vec2 c) {
-  const Scaler s({a.x, a.y, b.x, b.y, c.x, c.y}, 2);
-  a = s(a), b = s(b), c = s(c);
-  const Expansion bax = Expansion::Diff(b.x, a.x), bay = Expansion::Diff(b.y, a.y);
-  const Expansion cax = Expansion::Diff(c.x, a.x), cay = Expansion::Diff(c.y, a.y);
-  return (bax * cay - bay * cax).Sign();
+// Exact a − b.
+template <class T>
+T Diff(double a, double b) {
+  return Cv<T>(a) - Cv<T>(b);
+}
+template <>
+Expansion Diff<Expansion>(double a, double b) {
+  return Expansion::Diff(a, b);
 }
 
-int Orient3dExactImpl(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-  const Scaler s({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z}, 3);
-  a = s(a), b = s(b), c = s(c), d = s(d);
-  const Expansion bax = Expansion::Diff(b.x, a.x), bay = Expansion::Diff(b.y, a.y),
-                  baz = Expansion::Diff(b.z, a.z);
-  const Expansion cax = Expansion::Diff(c.x, a.x), cay = Expansion::Diff(c.y, a.y),
-                  caz = Expansion::Diff(c.z, a.z);
-  const Expansion dax = Expansion::Diff(d.x, a.x), day = Expansion::Diff(d.y, a.y),
-                  daz = Expansion::Diff(d.z, a.z);
-  const Expansion det = bax * (cay * daz - caz * day) + bay * (caz * dax - cax * daz) +
-                        baz * (cax * day - cay * dax);
-  return det.Sign();
+// ------------------------------------------------------------- scaling plan
+// Every predicate is a homogeneous polynomial of some degree d in the input
+// coordinates (or their differences), so scaling all inputs by 2^k (exact)
+// keeps its sign. Expansion arithmetic is exact when nothing overflows or
+// underflows. All inputs are integer multiples of 2^g (g = the lowest set bit
+// over all coordinates), hence so is every difference and every word of every
+// intermediate expansion of degree ≤ d a multiple of 2^(d·g): with d·(g+k) ≥
+// −1074 nothing can underflow inexactly (Dekker's halves keep the granularity
+// too). Overflow: keep the largest coordinate below 2^(960/d − 8), so that
+// sums of a few dozen products of d differences stay below 2^996, where the
+// split would overflow. We take k as large as allowed; if the lowest bit then
+// still falls below −1074/d (coordinates spanning more than ~2000/d binary
+// orders of magnitude, e.g. 1e120 next to a denormal), we fall back to GMP.
+struct ScalePlan {
+  int k = 0;
+  bool use_gmp = false;
+};
+
+int LowestSetBitExponent(double x) {
+  int e;
+  const double m = std::frexp(std::fabs(x), &e);  // |x| = m·2^e, m in [0.5, 1)
+  const uint64_t mant = static_cast<uint64_t>(std::ldexp(m, 53));
+  return e - 53 + __builtin_ctzll(mant);
+}
+
+ScalePlan PlanScaling(const double* v, int n, int degree) {
+  double m = 0;
+  int g = 1 << 20;
+  for (int i = 0; i < n; ++i) {
+    if (v[i] == 0) continue;
+    if (!std::isfinite(v[i])) return {};  // garbage in: no guarantee
+    m = std::max(m, std::fabs(v[i]));
+    g = std::min(g, LowestSetBitExponent(v[i]));
+  }
+  if (m == 0) return {};
+  ScalePlan plan;
+  plan.k = (960 / degree - 8) - std::ilogb(m);
+  if (degree * (g + plan.k) < -1074) plan.use_gmp = true;
+  return plan;
+}
+
+// Runs eval<T>(scaled coordinates) with T = Expansion, or with T = mpq_class
+// on the unscaled coordinates when the plan says so. `coords` holds n values.
+template <class Eval>
+int ExactSign(const double* coords, int n, int degree, Eval eval) {
+  const ScalePlan plan = PlanScaling(coords, n, degree);
+  if (plan.use_gmp) return eval(static_cast<mpq_class*>(nullptr), coords);
+  double scaled[32];
+  for (int i = 0; i < n; ++i) scaled[i] = plan.k == 0 ? coords[i] : std::ldexp(coords[i], plan.k);
+  return eval(static_cast<Expansion*>(nullptr), scaled);
+}
+
+// ------------------------------------------------------ exact core predicates
+// The same formulas as the inline filters, on exact differences. Coordinates
+// arrive flattened: point i at c[D*i ...].
+
+template <class T>
+int Orient2dPoly(const double* c) {
+  const T bax = Diff<T>(c[2], c[0]), bay = Diff<T>(c[3], c[1]);
+  const T cax = Diff<T>(c[4], c[0]), cay = Diff<T>(c[5], c[1]);
+  return SignOfT(bax * cay - bay * cax);
+}
+
+template <class T>
+int Orient3dPoly(const double* c) {
+  const T bax = Diff<T>(c[3], c[0]), bay = Diff<T>(c[4], c[1]), baz = Diff<T>(c[5], c[2]);
+  const T cax = Diff<T>(c[6], c[0]), cay = Diff<T>(c[7], c[1]), caz = Diff<T>(c[8], c[2]);
+  const T dax = Diff<T>(c[9], c[0]), day = Diff<T>(c[10], c[1]), daz = Diff<T>(c[11], c[2]);
+  return SignOfT(bax * (cay * daz - caz * day) + bay * (caz * dax - cax * daz) +
+                 baz * (cax * day - cay * dax));
+}
+
+template <class T>
+int InCirclePoly(const double* c) {
+  const T adx = Diff<T>(c[0], c[6]), ady = Diff<T>(c[1], c[7]);
+  const T bdx = Diff<T>(c[2], c[6]), bdy = Diff<T>(c[3], c[7]);
+  const T cdx = Diff<T>(c[4], c[6]), cdy = Diff<T>(c[5], c[7]);
+  const T alift = adx * adx + ady * ady;
+  const T blift = bdx * bdx + bdy * bdy;
+  const T clift = cdx * cdx + cdy * cdy;
+  return SignOfT(alift * (bdx * cdy - cdx * bdy) + blift * (cdx * ady - adx * cdy) +
+                 clift * (adx * bdy - bdx * ady));
+}
+
+template <class T>
+int InSpherePoly(const double* c) {
+  const T aex = Diff<T>(c[0], c[12]), aey = Diff<T>(c[1], c[13]), aez = Diff<T>(c[2], c[14]);
+  const T bex = Diff<T>(c[3], c[12]), bey = Diff<T>(c[4], c[13]), bez = Diff<T>(c[5], c[14]);
+  const T cex = Diff<T>(c[6], c[12]), cey = Diff<T>(c[7], c[13]), cez = Diff<T>(c[8], c[14]);
+  const T dex = Diff<T>(c[9], c[12]), dey = Diff<T>(c[10], c[13]), dez = Diff<T>(c[11], c[14]);
+  const T ab = aex * bey - bex * aey;
+  const T bc = bex * cey - cex * bey;
+  const T cd = cex * dey - dex * cey;
+  const T da = dex * aey - aex * dey;
+  const T ac = aex * cey - cex * aey;
+  const T bd = bex * dey - dex * bey;
+  const T abc = aez * bc - bez * ac + cez * ab;
+  const T bcd = bez * cd - cez * bd + dez * bc;
+  const T cda = cez * da + dez * ac + aez * cd;
+  const T dab = dez * ab + aez * bd + bez * da;
+  const T alift = aex * aex + aey * aey + aez * aez;
+  const T blift = bex * bex + bey * bey + bez * bez;
+  const T clift = cex * cex + cey * cey + cez * cez;
+  const T dlift = dex * dex + dey * dey + dez * dez;
+  return SignOfT((clift * dab - dlift * abc) + (alift * bcd - blift * cda));
+}
+
+int Orient2dExactImpl(Vec2 a, Vec2 b, Vec2 c) {
+  const double v[6] = {a.x, a.y, b.x, b.y, c.x, c.y};
+  return ExactSign(v, 6, 2, [](auto* tag, const double* q) {
+    return Orient2dPoly<std::remove_pointer_t<decltype(tag)>>(q);
+  });
+}
+
+int Orient3dExactImpl(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+  return ExactSign(v, 12, 3, [](auto* tag, const double* q) {
+    return Orient3dPoly<std::remove_pointer_t<decltype(tag)>>(q);
+  });
 }
 
 int InCircleExactImpl(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
-  const Scaler s({a.x, a.y, b.x, b.y, c.x, c.y, d.x, d.y}, 4);
-  a = s(a), b = s(b), c = s(c), d = s(d);
-  const Expansion adx = Expansion::Diff(a.x, d.x), ady = Expansion::Diff(a.y, d.y);
-  const Expansion bdx = Expansion::Diff(b.x, d.x), bdy = Expansion::Diff(b.y, d.y);
-  const Expansion cdx = Expansion::Diff(c.x, d.x), cdy = Expansion::Diff(c.y, d.y);
-  const Expansion alift = adx * adx + ady * ady;
-  const Expansion blift = bdx * bdx + bdy * bdy;
-  const Expansion clift = cdx * cdx + cdy * cdy;
-  const Expansion det = alift * (bdx * cdy - cdx * bdy) + blift * (cdx * ady - adx * cdy) +
-                        clift * (adx * bdy - bdx * ady);
-  return det.Sign();
+  const double v[8] = {a.x, a.y, b.x, b.y, c.x, c.y, d.x, d.y};
+  return ExactSign(v, 8, 4, [](auto* tag, const double* q) {
+    return InCirclePoly<std::remove_pointer_t<decltype(tag)>>(q);
+  });
 }
 
-int InSphereExactImpl(Vec3 a, Vec3 b, Vec3 c, Vec3 d, Vec3 e) {
-  const Scaler s({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z}, 5);
-  a = s(a), b = s(b), c = s(c), d = s(d), e = s(e);
-  const Expansion aex = Expansion::Diff(a.x, e.x), aey = Expansion::Diff(a.y, e.y),
-                  aez = Expansion::Diff(a.z, e.z);
-  const Expansion bex = Expansion::Diff(b.x, e.x), bey = Expansion::Diff(b.y, e.y),
-                  bez = Expansion::Diff(b.z, e.z);
-  const Expansion cex = Expansion::Diff(c.x, e.x), cey = Expansion::Diff(c.y, e.y),
-                  cez = Expansion::Diff(c.z, e.z);
-  const Expansion dex = Expansion::Diff(d.x, e.x), dey = Expansion::Diff(d.y, e.y),
-                  dez = Expansion::Diff(d.z, e.z);
-  const Expansion ab = aex * bey - bex * aey;
-  const Expansion bc = bex * cey - cex * bey;
-  const Expansion cd = cex * dey - dex * cey;
-  const Expansion da = dex * aey - aex * dey;
-  const Expansion ac = aex * cey - cex * aey;
-  const Expansion bd = bex * dey - dex * bey;
-  const Expansion abc = aez * bc - bez * ac + cez * ab;
-  const Expansion bcd = bez * cd - cez * bd + dez * bc;
-  const Expansion cda = cez * da + dez * ac + aez * cd;
-  const Expansion dab = dez * ab + aez * bd + bez * da;
-  const Expansion alift = aex * aex + aey * aey + aez * aez;
-  const Expansion blift = bex * bex + bey * bey + bez * bez;
-  const Expansion clift = cex * cex + cey * cey + cez * cez;
-  const Expansion dlift = dex * dex + dey * dey + dez * dez;
-  const Expansion det = (clift * dab - dlift * abc) + (alift * bcd - blift * cda);
-  return det.Sign();
+int InSphereExactImpl(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e) {
+  const double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z,
+                        d.x, d.y, d.z, e.x, e.y, e.z};
+  return ExactSign(v, 15, 5, [](auto* tag, const double* q) {
+    return InSpherePoly<std::remove_pointer_t<decltype(tag)>>(q);
+  });
 }
 
 // -------------------------------------------------- simulation of simplicity
 
 // Exact determinant of an n×n matrix (n ≤ 4) of doubles, row-major, by
 // Laplace expansion along the first column (zero entries skipped).
-Expansion DetExact(const double* m, int n, int stride) {
-  if (n == 1) return Expansion(m[0]);
-  if (n == 2) {
-    return Expansion::Product(m[0], m[stride + 1]) - Expansion::Product(m[1], m[stride]);
-  }
-  Expansion det;
+template <class T>
+T DetT(const double* m, int n, int stride) {
+  if (n == 1) return Cv<T>(m[0]);
+  if (n == 2) return Cv<T>(m[0]) * Cv<T>(m[stride + 1]) - Cv<T>(m[1]) * Cv<T>(m[stride]);
+  T det = Cv<T>(0);
   double minor[16];
   for (int r = 0; r < n; ++r) {
     if (m[r * stride] == 0) continue;
@@ -137,8 +206,12 @@ Expansion DetExact(const double* m, int n, int stride) {
       for (int j = 1; j < n; ++j) minor[k * (n - 1) + (j - 1)] = m[i * stride + j];
       ++k;
     }
-    const Expansion sub = DetExact(minor, n - 1, n - 1).Scale(m[r * stride]);
-    det = (r % 2 == 0) ? det + sub : det - sub;
+    const T sub = Cv<T>(m[r * stride]) * DetT<T>(minor, n - 1, n - 1);
+    if (r % 2 == 0) {
+      det += sub;
+    } else {
+      det -= sub;
+    }
   }
   return det;
 }
@@ -194,7 +267,11 @@ int OrientSoS(const double* coords, const uint32_t (&ids)[D + 1]) {
       for (int j = 0; j < N; ++j) row[j] = 0;
       row[bit_coord[bit]] = 1;
     }
-    const int s = DetExact(m, N, N).Sign();
+    // The coefficient is a homogeneous polynomial of degree N in the matrix
+    // entries (the 1s included), so scaling the whole matrix keeps its sign.
+    const int s = ExactSign(m, N * N, N, [](auto* tag, const double* q) {
+      return SignOfT(DetT<std::remove_pointer_t<decltype(tag)>>(q, N, N));
+    });
     if (s != 0) return s;
   }
   return 0;  // unreachable: a mask covering every coordinate gives ±1
@@ -256,18 +333,14 @@ int InSphereExact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, co
 
 int Orient2dSoSTail(Vec2 a, Vec2 b, Vec2 c, uint32_t ia, uint32_t ib, uint32_t ic) {
   CountSos(Pred::kOrient2d);
-  const Scaler s({a.x, a.y, b.x, b.y, c.x, c.y}, 2);
-  a = s(a), b = s(b), c = s(c);
   const double coords[6] = {a.x, a.y, b.x, b.y, c.x, c.y};
   const uint32_t ids[3] = {ia, ib, ic};
   return OrientSoS<2>(coords, ids);
 }
 
-int Orient3dSoSTail(const Vec3& a0, const Vec3& b0, const Vec3& c0, const Vec3& d0, uint32_t ia,
+int Orient3dSoSTail(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, uint32_t ia,
                     uint32_t ib, uint32_t ic, uint32_t id) {
   CountSos(Pred::kOrient3d);
-  const Scaler s({a0.x, a0.y, a0.z, b0.x, b0.y, b0.z, c0.x, c0.y, c0.z, d0.x, d0.y, d0.z}, 3);
-  const Vec3 a = s(a0), b = s(b0), c = s(c0), d = s(d0);
   const double coords[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
   const uint32_t ids[4] = {ia, ib, ic, id};
   return OrientSoS<3>(coords, ids);
@@ -332,7 +405,6 @@ struct Fp {
   double e = 0;
 };
 constexpr double kTiny = 1e-300;
-inline Fp FromDouble(double x, Fp*) { return {x, 0}; }
 inline Fp operator+(Fp a, Fp b) {
   const double v = a.v + b.v;
   return {v, a.e + b.e + internal::kU * std::fabs(v) + kTiny};
@@ -354,11 +426,13 @@ inline int FilteredSign(Fp x, bool* certain) {
   *certain = std::fabs(x.v) > bound;  // false for NaN/Inf too
   return SignOf(x.v);
 }
-inline Expansion FromDouble(double x, Expansion*) { return Expansion(x); }
-
 template <class T>
-T Cv(double x) {
-  return FromDouble(x, static_cast<T*>(nullptr));
+T CvX(double x) {
+  if constexpr (std::is_same_v<T, Fp>) {
+    return Fp{x, 0};
+  } else {
+    return Cv<T>(x);
+  }
 }
 
 template <class T>
@@ -367,7 +441,7 @@ struct V3 {
 };
 template <class T>
 V3<T> Sub(const Vec3& a, const Vec3& b) {
-  return {Cv<T>(a.x) - Cv<T>(b.x), Cv<T>(a.y) - Cv<T>(b.y), Cv<T>(a.z) - Cv<T>(b.z)};
+  return {CvX<T>(a.x) - CvX<T>(b.x), CvX<T>(a.y) - CvX<T>(b.y), CvX<T>(a.z) - CvX<T>(b.z)};
 }
 template <class T>
 T DotT(const V3<T>& a, const V3<T>& b) {
@@ -407,8 +481,8 @@ T DotSignPoly(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 template <class T>
 T Orient2dProjectedPoly(const Vec3& a, const Vec3& b, const Vec3& c, int axis) {
   const int i = (axis + 1) % 3, j = (axis + 2) % 3;
-  const T bai = Cv<T>(b[i]) - Cv<T>(a[i]), baj = Cv<T>(b[j]) - Cv<T>(a[j]);
-  const T cai = Cv<T>(c[i]) - Cv<T>(a[i]), caj = Cv<T>(c[j]) - Cv<T>(a[j]);
+  const T bai = CvX<T>(b[i]) - CvX<T>(a[i]), baj = CvX<T>(b[j]) - CvX<T>(a[j]);
+  const T cai = CvX<T>(c[i]) - CvX<T>(a[i]), caj = CvX<T>(c[j]) - CvX<T>(a[j]);
   return bai * caj - baj * cai;
 }
 
@@ -423,23 +497,18 @@ int Decide(Pred pred, int degree, std::initializer_list<Vec3> pts, Eval eval) {
   const int s = FilteredSign(eval(static_cast<Fp*>(nullptr), pts.begin()), &certain);
   if (certain) return s;
   CountExact(pred);
-  double mags[18];
-  int k = 0;
-  for (const Vec3& p : pts) {
-    mags[k++] = p.x;
-    mags[k++] = p.y;
-    mags[k++] = p.z;
-  }
-  double m = 0;
-  for (int i = 0; i < k; ++i) m = std::max(m, std::fabs(mags[i]));
-  Vec3 scaled[6];
-  int e = 0;
-  if (m != 0 && std::isfinite(m)) e = TargetExponent(degree) - std::ilogb(m);
+  double coords[18];
   int n = 0;
   for (const Vec3& p : pts) {
-    scaled[n++] = {std::ldexp(p.x, e), std::ldexp(p.y, e), std::ldexp(p.z, e)};
+    coords[n++] = p.x;
+    coords[n++] = p.y;
+    coords[n++] = p.z;
   }
-  return eval(static_cast<Expansion*>(nullptr), scaled).Sign();
+  return ExactSign(coords, n, degree, [&eval, n](auto* tag, const double* q) {
+    Vec3 scaled[6];
+    for (int i = 0; i < n / 3; ++i) scaled[i] = {q[3 * i], q[3 * i + 1], q[3 * i + 2]};
+    return SignOfT(eval(tag, scaled));
+  });
 }
 
 }  // namespace

@@ -10,8 +10,10 @@
 //      Shewchuk's stage-A bounds (derivation next to each constant below);
 //   2. when |det| is not above the bound, an out-of-line exact evaluation with
 //      expansion arithmetic (core/geometry/expansion.h), inputs first rescaled
-//      by a power of two so that no intermediate product over/underflows
-//      (exact as long as the input coordinates span < ~2^200 in magnitude);
+//      by a power of two so that no intermediate product over/underflows. If
+//      the coordinates' binary exponents span too wide a range for that (about
+//      2000/degree orders of two, e.g. 1e120 next to a denormal), GMP rationals
+//      evaluate the same polynomial instead. Exact for all finite inputs;
 //   3. for the *SoS variants, when the exact value is 0, simulation of
 //      simplicity by caller-supplied global ids (see the SoS section below).
 //

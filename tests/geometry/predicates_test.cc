@@ -25,22 +25,46 @@ using Q = mpq_class;
 
 // ---------------------------------------------------------------- oracle
 
-// Determinant of an n×n rational matrix (fraction-free Gaussian elimination
-// would be faster; n ≤ 5 so Laplace is fine).
+// Determinant of an n×n rational matrix by Gaussian elimination.
 Q Det(std::vector<std::vector<Q>> m) {
   const size_t n = m.size();
+  Q det = 1;
+  for (size_t col = 0; col < n; ++col) {
+    size_t pivot = col;
+    while (pivot < n && sgn(m[pivot][col]) == 0) ++pivot;
+    if (pivot == n) return 0;
+    if (pivot != col) {
+      std::swap(m[pivot], m[col]);
+      det = -det;
+    }
+    det *= m[col][col];
+    for (size_t r = col + 1; r < n; ++r) {
+      if (sgn(m[r][col]) == 0) continue;
+      const Q f = m[r][col] / m[col][col];
+      for (size_t c = col; c < n; ++c) m[r][c] -= f * m[col][c];
+    }
+  }
+  return det;
+}
+
+// Laplace expansion: better than elimination for the SoS oracle, whose
+// entries carry huge powers of ε (no divisions).
+Q DetLaplace(const std::vector<std::vector<Q>>& m) {
+  const size_t n = m.size();
   if (n == 1) return m[0][0];
-  if (n == 2) return m[0][0] * m[1][1] - m[0][1] * m[1][0];
   Q det = 0;
   for (size_t r = 0; r < n; ++r) {
     if (sgn(m[r][0]) == 0) continue;
     std::vector<std::vector<Q>> minor;
     for (size_t i = 0; i < n; ++i) {
-      if (i == r) continue;
-      minor.emplace_back(m[i].begin() + 1, m[i].end());
+      if (i != r) minor.emplace_back(m[i].begin() + 1, m[i].end());
     }
-    const Q sub = m[r][0] * Det(minor);
-    if (r % 2 == 0) det += sub; else det -= sub;
+    const Q sub = m[r][0] * DetLaplace(minor);
+    if (r % 2 == 0) {
+      det += sub;
+    } else {
+      det -= sub;
+    }
   }
   return det;
 }
@@ -414,7 +438,7 @@ int OracleOrientSoS(const std::array<std::array<double, D>, D + 1>& pts,
     }
     m.push_back(row);
   }
-  return sgn(Det(m));
+  return sgn(DetLaplace(m));
 }
 
 // Oracle for the lifting perturbation: |p|² + ε^rank.
