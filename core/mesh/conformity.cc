@@ -345,8 +345,8 @@ class Checker {
     CheckVolume();
     CheckInputVertices();
     CheckSegments();
-    CheckFacetCoverage();
     CheckCrossings();
+    CheckFacetCoverage();
   }
 
  private:
@@ -831,6 +831,12 @@ class Checker {
     }
     for (size_t f = 0; f < facets_.size(); ++f) {
       if (!facets_[f].valid) continue;
+      // A facet no tet touches lies outside the meshed domain (e.g. between a
+      // volume hole and the exterior): TetGen and we drop it.
+      if (covered[f] == 0 && !facet_crossed_[f] && !AnyTetFaceOn(f)) {
+        ++rep_->num_facets_outside;
+        continue;
+      }
       const double want = facets_[f].area;
       if (std::fabs(covered[f] - want) > opt_.area_rel_tol * want) {
         Add(rep_, opt_, ViolationKind::kFacetNotCovered, {static_cast<int64_t>(f)},
@@ -840,15 +846,47 @@ class Checker {
     }
   }
 
-  void CheckCrossings() {
-    if (mesh_box_.Empty() || mesh_.tets.empty()) return;
-    BoxGrid tet_grid(mesh_box_, mesh_.tets.size(), 4, 128, [&](size_t t) {
-      Box3 b;
-      if (tet_ok_[t]) {
-        for (uint32_t v : mesh_.tets[t]) b.Add(P(v));
+  const BoxGrid& TetGrid() {
+    if (tet_grid_ == nullptr) {
+      tet_grid_ = std::make_unique<BoxGrid>(mesh_box_, mesh_.tets.size(), 4, 128, [&](size_t t) {
+        Box3 b;
+        if (tet_ok_[t]) {
+          for (uint32_t v : mesh_.tets[t]) b.Add(P(v));
+        }
+        return b;
+      });
+    }
+    return *tet_grid_;
+  }
+
+  // True when some face of some tet lies on facet f (vertices on its plane,
+  // centroid in its region).
+  bool AnyTetFaceOn(size_t f) {
+    if (mesh_box_.Empty() || mesh_.tets.empty()) return false;
+    const FacetGeom& fg = facets_[f];
+    bool found = false;
+    TetGrid().Query(Expand(fg.box, tol_), [&](uint32_t t) {
+      if (found || !tet_ok_[t]) return;
+      const auto& q = mesh_.tets[t];
+      int on = 0;
+      for (int i = 0; i < 4; ++i) on += SideOf(fg.plane, P(q[i]), tol_) == 0 ? 1 : 0;
+      if (on < 3) return;
+      for (const auto& face : kFace) {
+        const Vec3 &a = P(q[face[0]]), &b = P(q[face[1]]), &c = P(q[face[2]]);
+        if (SideOf(fg.plane, a, tol_) == 0 && SideOf(fg.plane, b, tol_) == 0 &&
+            SideOf(fg.plane, c, tol_) == 0 && InFacetRegion(fg, (a + b + c) / 3.0)) {
+          found = true;
+          return;
+        }
       }
-      return b;
     });
+    return found;
+  }
+
+  void CheckCrossings() {
+    facet_crossed_.assign(facets_.size(), 0);
+    if (mesh_box_.Empty() || mesh_.tets.empty()) return;
+    const BoxGrid& tet_grid = TetGrid();
     std::vector<uint32_t> stamp(mesh_.tets.size(), kNone);
     for (size_t f = 0; f < facets_.size(); ++f) {
       const FacetGeom& fg = facets_[f];
@@ -905,6 +943,7 @@ class Checker {
           overlap += lp.outer ? a : -a;
         }
         if (overlap > 1e-9 * sec_area) {
+          facet_crossed_[f] = 1;
           Add(rep_, opt_, ViolationKind::kTetCrossesFacet, {t, static_cast<int64_t>(f)},
               absl::StrFormat("tet %d crosses facet %d (overlap area %.3g)", t, f,
                               overlap / proj));
@@ -925,6 +964,8 @@ class Checker {
   double tol_ = 0;
   std::vector<FacetGeom> facets_;
   std::unique_ptr<BoxGrid> facet_grid_;
+  std::unique_ptr<BoxGrid> tet_grid_;
+  std::vector<uint8_t> facet_crossed_;
   std::vector<uint32_t> facet_stamp_;
   uint32_t query_ = 0;
   std::vector<uint32_t> input_map_;

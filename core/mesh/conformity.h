@@ -36,7 +36,8 @@ enum class ViolationKind {
   kMissingInputVertex,    // ids: input vertex
   kInputVertexIndex,      // ids: input vertex, mesh vertex (canonical meshes only)
   kBrokenSegment,         // ids: segment (index into ConformitySegments), mesh vertex where the walk stopped
-  kFacetNotCovered,       // ids: facet; triangle area on it != facet area
+  kFacetNotCovered,       // ids: facet; triangle area on it != facet area (facets
+                          // that no tet face lies on are outside the domain: skipped)
   kTriangleOffFacet,      // ids: triangle (lies on no input facet)
   kWrongMarker,           // ids: triangle, facet
   kTetCrossesFacet,       // ids: tet, facet
@@ -77,7 +78,8 @@ struct ConformityReport {
   double enclosed_volume = 0;
   bool enclosed_volume_known = false;  // see docs/conformity.md for when
   size_t num_segments_checked = 0;
-  size_t num_facets_checked = 0;
+  size_t num_facets_checked = 0;   // valid (planar, non-degenerate) facets
+  size_t num_facets_outside = 0;   // of those, touched by no tet: outside the domain
 
   bool ok() const;
   size_t Count(ViolationKind kind) const { return counts[static_cast<int>(kind)]; }
