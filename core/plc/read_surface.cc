@@ -186,6 +186,7 @@ absl::Status ReadAsciiStl(std::string_view bytes, const std::string& name, Surfa
 // Binary when the size is exactly 84 + 50 n for the count n at offset 80
 // (ASCII files may start with "solid" in binary headers too); else ASCII.
 absl::Status ReadStl(std::string_view bytes, const std::string& name, SurfaceSoup* soup) {
+  soup->index_base = 1;  // facets and vertices numbered from 1 in messages, as TetGen does
   if (bytes.size() >= 84) {
     uint32_t n = 0;
     std::memcpy(&n, bytes.data() + 80, 4);
