@@ -37,9 +37,11 @@ uint64_t HilbertIndex21(uint32_t x, uint32_t y, uint32_t z) {
   return key;
 }
 
-std::vector<uint32_t> HilbertOrder(std::span<const geom::Vec3> pts) {
+std::vector<uint32_t> HilbertOrder(std::span<const geom::Vec3> pts,
+                                   std::vector<uint64_t>* sorted_keys) {
   const size_t n = pts.size();
   std::vector<uint32_t> order(n);
+  if (sorted_keys) sorted_keys->clear();
   if (n == 0) return order;
   geom::Box3 box;
   for (const auto& p : pts) box.Add(p);
@@ -59,6 +61,10 @@ std::vector<uint32_t> HilbertOrder(std::span<const geom::Vec3> pts) {
   }
   std::sort(keyed.begin(), keyed.end());
   for (size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+  if (sorted_keys) {
+    sorted_keys->resize(n);
+    for (size_t i = 0; i < n; ++i) (*sorted_keys)[i] = keyed[i].first;
+  }
   return order;
 }
 

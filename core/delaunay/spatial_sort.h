@@ -16,8 +16,11 @@ namespace svrc::delaunay {
 uint64_t HilbertIndex21(uint32_t x, uint32_t y, uint32_t z);
 
 // Indices [0, pts.size()) sorted by the Hilbert index of each point quantized
-// on the points' bounding cube (ties by index). Points must be finite.
-std::vector<uint32_t> HilbertOrder(std::span<const geom::Vec3> pts);
+// on the points' bounding cube (ties by index). Points must be finite. If
+// `sorted_keys` is set it receives the Hilbert index of each entry of the
+// result (equal points have equal keys).
+std::vector<uint32_t> HilbertOrder(std::span<const geom::Vec3> pts,
+                                   std::vector<uint64_t>* sorted_keys = nullptr);
 
 // BRIO: a point goes to round k >= 0 with probability 2^-(k+1) (the last
 // round holds about half of the points), decided by a hash of its index; the
