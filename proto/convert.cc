@@ -9,13 +9,6 @@
 namespace svrc::api {
 namespace {
 
-absl::Status CheckFinite(const char* name, double value) {
-  if (!std::isfinite(value)) {
-    return absl::InvalidArgumentError(absl::StrCat(name, " must be finite, got ", value));
-  }
-  return absl::OkStatus();
-}
-
 absl::Status ReadTriples(const google::protobuf::RepeatedField<double>& values,
                          const char* what, std::vector<geom::Vec3>* out) {
   if (values.size() % 3 != 0) {
@@ -41,86 +34,51 @@ void WriteTriples(const std::vector<geom::Vec3>& points,
 
 }  // namespace
 
-absl::StatusOr<core::MeshParams> ParamsFromProto(const v1::MeshParameters& params,
-                                                 const v1::JobLimits& limits) {
-  core::MeshParams out;
-  if (params.has_radius_edge()) {
-    if (auto s = CheckFinite("radius_edge", params.radius_edge()); !s.ok()) return s;
-    if (params.radius_edge() <= 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("radius_edge must be > 0, got ", params.radius_edge()));
+absl::StatusOr<cli::MeshOptions> OptionsFromRequest(const v1::SubmitJobRequest& request) {
+  const v1::MeshParameters& p = request.parameters();
+  cli::MeshOptions o;
+  if (p.has_radius_edge()) o.radius_edge = p.radius_edge();
+  if (p.has_theta()) o.theta = p.theta();
+  if (p.has_max_rep_angle()) o.max_rep_angle = p.max_rep_angle();
+  if (p.has_max_volume()) o.max_volume = p.max_volume();
+  if (p.has_min_dihedral()) o.min_dihedral = p.min_dihedral();
+  if (p.has_keep_bounding_box()) o.keep_bounding_box = p.keep_bounding_box();
+  o.max_vertices = request.limits().max_vertices();
+  if (request.limits().has_deadline()) {
+    const auto& d = request.limits().deadline();
+    if (d.seconds() < 0 || d.nanos() < 0 || d.nanos() > 999999999 ||
+        d.seconds() > google::protobuf::util::TimeUtil::kDurationMaxSeconds) {
+      return absl::InvalidArgumentError("limits.deadline must be a valid non-negative duration");
     }
-    out.radius_edge = params.radius_edge();
+    o.deadline = absl::Seconds(d.seconds()) + absl::Nanoseconds(d.nanos());
   }
-  if (params.has_theta()) {
-    if (auto s = CheckFinite("theta", params.theta()); !s.ok()) return s;
-    if (params.theta() < 0 || params.theta() > 1) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("theta must be in [0, 1], got ", params.theta()));
-    }
-    out.theta = params.theta();
-  }
-  if (params.has_max_rep_angle()) {
-    if (auto s = CheckFinite("max_rep_angle", params.max_rep_angle()); !s.ok()) return s;
-    if (params.max_rep_angle() <= 0 || params.max_rep_angle() >= 180) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("max_rep_angle must be in (0, 180) degrees, got ", params.max_rep_angle()));
-    }
-    out.max_rep_angle = params.max_rep_angle();
-  }
-  if (params.has_max_volume()) {
-    if (auto s = CheckFinite("max_volume", params.max_volume()); !s.ok()) return s;
-    out.max_volume = params.max_volume();
-  }
-  if (params.has_min_dihedral()) {
-    if (auto s = CheckFinite("min_dihedral", params.min_dihedral()); !s.ok()) return s;
-    if (params.min_dihedral() >= 90) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("min_dihedral must be < 90 degrees, got ", params.min_dihedral()));
-    }
-    out.min_dihedral = params.min_dihedral();
-  }
-  if (params.has_keep_bounding_box()) out.keep_bounding_box = params.keep_bounding_box();
-  out.max_vertices = limits.max_vertices();
-  return out;
-}
-
-absl::Status CheckImplemented(const v1::MeshParameters& params, const plc::Plc& plc) {
-  if (!plc.IsPointSet()) return absl::OkStatus();  // the mesher decides
-  std::vector<const char*> set;
-  if (params.has_radius_edge()) set.push_back("radius_edge");
-  if (params.has_theta()) set.push_back("theta");
-  if (params.has_max_rep_angle()) set.push_back("max_rep_angle");
-  if (params.has_max_volume() && params.max_volume() > 0) set.push_back("max_volume");
-  if (params.has_min_dihedral() && params.min_dihedral() > 0) set.push_back("min_dihedral");
-  if (params.has_keep_bounding_box() && params.keep_bounding_box()) {
-    set.push_back("keep_bounding_box");
-  }
-  if (set.empty()) return absl::OkStatus();
-  std::string names;
-  for (const char* n : set) absl::StrAppend(&names, names.empty() ? "" : ", ", n);
-  return absl::UnimplementedError(absl::StrCat(
-      "parameter(s) ", names,
-      " not implemented for point sets (a point set is tetrahedralized as given, "
-      "without refinement)"));
-}
-
-absl::Status ValidateEncoding(const v1::EncodingOptions& encoding) {
-  if (encoding.quantization_bits() > 24) {
+  if (request.encoding().quantization_bits() > 24) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "quantization_bits must be 0 (lossless) or 1..24, got ", encoding.quantization_bits()));
+        "quantization_bits must be 0 (lossless) or 1..24, got ",
+        request.encoding().quantization_bits()));
   }
-  return absl::OkStatus();
+  o.quantization_bits = static_cast<int>(request.encoding().quantization_bits());
+  if (absl::Status s = cli::ValidateOptions(o); !s.ok()) return s;
+  return o;
 }
 
-absl::StatusOr<absl::Duration> DeadlineFromProto(const v1::JobLimits& limits) {
-  if (!limits.has_deadline()) return absl::ZeroDuration();
-  const auto& d = limits.deadline();
-  if (d.seconds() < 0 || d.nanos() < 0 || d.nanos() > 999999999 ||
-      d.seconds() > google::protobuf::util::TimeUtil::kDurationMaxSeconds) {
-    return absl::InvalidArgumentError("limits.deadline must be a valid non-negative duration");
+void OptionsToRequest(const cli::MeshOptions& o, v1::SubmitJobRequest* request) {
+  v1::MeshParameters* p = request->mutable_parameters();
+  if (o.radius_edge) p->set_radius_edge(*o.radius_edge);
+  if (o.theta) p->set_theta(*o.theta);
+  if (o.max_rep_angle) p->set_max_rep_angle(*o.max_rep_angle);
+  if (o.max_volume) p->set_max_volume(*o.max_volume);
+  if (o.min_dihedral) p->set_min_dihedral(*o.min_dihedral);
+  if (o.keep_bounding_box) p->set_keep_bounding_box(*o.keep_bounding_box);
+  if (o.max_vertices > 0) request->mutable_limits()->set_max_vertices(o.max_vertices);
+  if (o.deadline > absl::ZeroDuration()) {
+    const int64_t ns = absl::ToInt64Nanoseconds(o.deadline);
+    request->mutable_limits()->mutable_deadline()->set_seconds(ns / 1000000000);
+    request->mutable_limits()->mutable_deadline()->set_nanos(static_cast<int32_t>(ns % 1000000000));
   }
-  return absl::Seconds(d.seconds()) + absl::Nanoseconds(d.nanos());
+  if (o.quantization_bits > 0) {
+    request->mutable_encoding()->set_quantization_bits(static_cast<uint32_t>(o.quantization_bits));
+  }
 }
 
 absl::StatusOr<plc::Plc> PlcFromProto(const v1::Plc& proto) {
@@ -224,29 +182,6 @@ std::string JobStateName(v1::JobState state) { return v1::JobState_Name(state); 
 
 bool IsTerminal(v1::JobState state) {
   return state == v1::SUCCEEDED || state == v1::FAILED || state == v1::CANCELLED;
-}
-
-}  // namespace svrc::api
-
-namespace svrc::api {
-
-absl::StatusOr<mesh::TetMesh> MeshWithParameters(const plc::Plc& plc,
-                                                 const v1::MeshParameters& params,
-                                                 const v1::JobLimits& limits,
-                                                 const core::ProgressCallback& progress,
-                                                 const core::CancelToken* cancel) {
-  absl::StatusOr<core::MeshParams> core_params = ParamsFromProto(params, limits);
-  if (!core_params.ok()) return core_params.status();
-  if (absl::Status s = CheckImplemented(params, plc); !s.ok()) return s;
-  if (limits.max_vertices() > 0 && plc.vertices.size() > limits.max_vertices()) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the input has ", plc.vertices.size(), " vertices, more than max_vertices=",
-                     limits.max_vertices()));
-  }
-  if (cancel != nullptr) {
-    if (absl::Status s = cancel->Check(); !s.ok()) return s;
-  }
-  return core::MeshPlc(plc, *core_params, progress, cancel);
 }
 
 }  // namespace svrc::api

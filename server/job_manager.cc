@@ -79,13 +79,9 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request) {
                                                      " bytes exceeds the server's limit of ",
                                                      options_.max_input_bytes));
   }
-  if (absl::Status s = api::ParamsFromProto(request.parameters(), request.limits()).status();
-      !s.ok()) {
-    return s;
-  }
-  if (absl::Status s = api::ValidateEncoding(request.encoding()); !s.ok()) return s;
-  absl::StatusOr<absl::Duration> deadline = api::DeadlineFromProto(request.limits());
-  if (!deadline.ok()) return deadline.status();
+  absl::StatusOr<cli::MeshOptions> options = api::OptionsFromRequest(request);
+  if (!options.ok()) return options.status();
+  const absl::Duration deadline = options->deadline;
 
   absl::MutexLock lock(&mu_);
   if (!accepting_) return absl::UnavailableError("server is shutting down; not accepting jobs");
@@ -108,10 +104,10 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request) {
   auto rec = std::make_unique<JobRecord>();
   rec->seq = next_seq_++;
   const absl::Time now = absl::Now();
-  if (*deadline > absl::ZeroDuration()) {
-    rec->deadline = now + *deadline;
+  if (deadline > absl::ZeroDuration()) {
+    rec->deadline = now + deadline;
     rec->cancel.SetDeadline(std::chrono::steady_clock::now() +
-                            absl::ToChronoNanoseconds(*deadline));
+                            absl::ToChronoNanoseconds(deadline));
   }
   v1::Job& job = rec->job;
   job.set_job_id(id);
@@ -366,15 +362,17 @@ absl::Status JobManager::Execute(JobRecord* rec, const v1::SubmitJobRequest& req
   if (!plc.ok()) return plc.status();
   ServerLog().info("job {}: input read ({} vertices, {} segments, {} facets)", id,
                    plc->vertices.size(), plc->segments.size(), plc->facets.size());
-  absl::StatusOr<mesh::TetMesh> mesh = api::MeshWithParameters(
-      *plc, request.parameters(), request.limits(),
+  absl::StatusOr<cli::MeshOptions> options = api::OptionsFromRequest(request);
+  if (!options.ok()) return options.status();
+  absl::StatusOr<mesh::TetMesh> mesh = cli::RunMeshing(
+      *plc, *options,
       [this, rec](const core::Progress& p) { OnProgress(rec, p); }, &rec->cancel);
   *plc = plc::Plc();  // the job's memory goes as soon as it is not needed
   if (!mesh.ok()) return mesh.status();
   if (absl::Status s = rec->cancel.Check(); !s.ok()) return s;
   phase("encode");
   codec::EncodeOptions encode_options;
-  encode_options.position_quantization_bits = static_cast<int>(request.encoding().quantization_bits());
+  encode_options.position_quantization_bits = options->quantization_bits;
   codec::EncodeReport report;
   absl::StatusOr<std::string> bytes = codec::EncodeTetMesh(*mesh, encode_options, &report);
   if (!bytes.ok()) return bytes.status();

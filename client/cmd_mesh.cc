@@ -1,0 +1,93 @@
+// svrc mesh IN -o OUT [mesh flags]: meshes locally, no server. The same
+// pipeline as the server's workers (client/mesh_job.h), so a remote job's
+// output is byte-identical to this command's for the same input and flags.
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "client/cli_util.h"
+#include "client/command.h"
+#include "core/codec/container.h"
+#include "core/plc/readers.h"
+
+namespace svrc::cli {
+namespace {
+
+int RunMesh(const std::vector<std::string>& argv);
+
+const Command kMesh{
+    "mesh",
+    "mesh IN -o OUT [--radius-edge X] [--max-volume V] [--theta T] [--max-rep-angle A] "
+    "[--min-dihedral D] [--keep-bounding-box] [--max-vertices N] [--deadline 30s] "
+    "[--quantization-bits B] [--quiet]   (OUT: .node .vtu .msh .mesh .svrc)",
+    &RunMesh};
+const RegisterCommand kRegister{kMesh};
+
+int RunMesh(const std::vector<std::string>& argv) {
+  std::vector<std::string> values = MeshValueFlags();
+  values.push_back("-o");
+  std::vector<std::string> switches = MeshSwitches();
+  switches.push_back("--quiet");
+  absl::StatusOr<Args> args = ParseArgs(argv, values, switches);
+  if (!args.ok()) return UsageError(kMesh, std::string(args.status().message()));
+  if (args->positional.size() != 1) return UsageError(kMesh, "expected one input file");
+  const std::string out = args->Get("-o");
+  if (out.empty()) return UsageError(kMesh, "missing -o OUT");
+  absl::StatusOr<MeshOptions> options = MeshOptionsFromArgs(*args);
+  if (!options.ok()) return UsageError(kMesh, std::string(options.status().message()));
+
+  const std::string& in = args->positional[0];
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(in);
+  if (!plc.ok()) {
+    return Fail(plc.status().code() == absl::StatusCode::kInvalidArgument ||
+                        plc.status().code() == absl::StatusCode::kNotFound
+                    ? kExitInvalidInput
+                    : ExitCodeFor(plc.status(), true),
+                std::string(plc.status().message()));
+  }
+  core::CancelToken cancel;
+  if (options->deadline > absl::ZeroDuration()) {
+    cancel.SetDeadline(std::chrono::steady_clock::now() +
+                       absl::ToChronoNanoseconds(options->deadline));
+  }
+  ProgressPrinter printer(!args->switches.count("--quiet"));
+  const auto start = std::chrono::steady_clock::now();
+  absl::StatusOr<mesh::TetMesh> mesh = RunMeshing(
+      *plc, *options,
+      [&](const core::Progress& p) {
+        const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        printer.Update("local", p.phase, p.vertices, p.queue_size, p.largest_work_radius,
+                       p.target_radius, t);
+      },
+      &cancel);
+  printer.Done();
+  if (!mesh.ok()) {
+    return Fail(ExitCodeFor(mesh.status(), true),
+                absl::StrCat(in, ": ", absl::StatusCodeToString(mesh.status().code()), ": ",
+                             mesh.status().message()));
+  }
+  // A quantized container is lossy: write what a remote client would decode
+  // from it, so that local and remote outputs stay byte-identical.
+  if (options->quantization_bits > 0 && !absl::EndsWithIgnoreCase(out, ".svrc")) {
+    codec::EncodeOptions encode;
+    encode.position_quantization_bits = options->quantization_bits;
+    absl::StatusOr<std::string> bytes = codec::EncodeTetMesh(*mesh, encode);
+    if (!bytes.ok()) return Fail(kExitJobFailed, std::string(bytes.status().message()));
+    mesh = codec::DecodeTetMesh(*bytes);
+    if (!mesh.ok()) return Fail(kExitJobFailed, std::string(mesh.status().message()));
+  }
+  if (absl::Status s = WriteMeshOutput(*mesh, out, options->quantization_bits); !s.ok()) {
+    return Fail(kExitJobFailed, absl::StrCat("cannot write ", out, ": ", s.message()));
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("wrote %s: %zu vertices, %zu tets, %zu boundary triangles in %.3f s\n", out.c_str(),
+              mesh->num_vertices(), mesh->num_tets(), mesh->triangles.size(), seconds);
+  return kExitOk;
+}
+
+}  // namespace
+}  // namespace svrc::cli
