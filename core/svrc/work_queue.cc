@@ -182,6 +182,26 @@ void WorkQueues::DecreaseSize(EventHandle handle, double new_radius) {
   Link(e, q, bucket);
 }
 
+void WorkQueues::Refresh(EventHandle handle, uint32_t generation, const geom::Vec3& center,
+                         double radius) {
+  if (!IsQueued(handle) || !std::isfinite(radius) || radius < 0) return;
+  const uint32_t e = handle.id.value();
+  entries_[e].event.generation = generation;
+  entries_[e].event.center = center;
+  if (radius <= entries_[e].event.radius) {
+    DecreaseSize(handle, radius);
+    return;
+  }
+  ++stats_.increase_size;
+  entries_[e].event.radius = radius;
+  const int bucket = BucketOf(radius);
+  if (bucket != entries_[e].bucket) {
+    const int q = entries_[e].queue;
+    Unlink(e);
+    Link(e, q, bucket);
+  }
+}
+
 void WorkQueues::Remove(EventHandle handle) {
   if (!IsQueued(handle)) return;
   Unlink(handle.id.value());

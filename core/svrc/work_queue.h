@@ -89,6 +89,13 @@ class WorkQueues {
   // `buckets_walked` grows by the number of buckets between old and new.
   void DecreaseSize(EventHandle handle, double new_radius);
 
+  // ForceInsert's refresh of a cell-keyed event after the cell changed
+  // (Figure 3.5): new generation and centre, and DecreaseSize to the new
+  // radius. Cells only shrink when points are added, so a larger radius is
+  // rounding noise: it is stored in place (same bucket) or re-bucketed and
+  // counted as `increase_size`. No-op on a stale handle.
+  void Refresh(EventHandle handle, uint32_t generation, const geom::Vec3& center, double radius);
+
   // Removes a queued event eagerly (lazy deletion is the norm; this is for
   // callers that hold a handle anyway). No-op on a stale handle.
   void Remove(EventHandle handle);
@@ -109,6 +116,7 @@ class WorkQueues {
     std::array<uint64_t, kNumEventTypes> stale{};
     uint64_t rejected = 0;
     uint64_t decrease_size = 0;
+    uint64_t increase_size = 0;
     // Empty buckets stepped over by Dequeue's cursor plus buckets skipped by
     // DecreaseSize: Lemmas 30–31 say O(1) per operation.
     uint64_t buckets_walked = 0;

@@ -1,0 +1,174 @@
+// Feature meshes (thesis §3.1–3.2): M_Ω with cells clipped to the cube Ω.
+#include "core/svrc/feature_meshes.h"
+
+#include <cmath>
+
+#include "core/geometry/predicates.h"
+#include "core/svrc/balls.h"
+
+namespace svrc::refine {
+
+using geom::Vec3;
+
+OmegaMesh::OmegaMesh(const Vec3& center, double half_side) : half_side_(half_side) {
+  cube_.Add(center - Vec3(half_side, half_side, half_side));
+  cube_.Add(center + Vec3(half_side, half_side, half_side));
+}
+
+Vec3 OmegaMesh::Corner(int i) const {
+  return {(i & 1) ? cube_.hi.x : cube_.lo.x, (i & 2) ? cube_.hi.y : cube_.lo.y,
+          (i & 4) ? cube_.hi.z : cube_.lo.z};
+}
+
+void OmegaMesh::SeedCorners(const std::array<PointId, 8>& ids) {
+  for (int i = 0; i < 8; ++i) {
+    const auto r = dt_.Insert(Corner(i), ids[i].value());
+    AddVertex(r.vertex, ids[i]);
+  }
+}
+
+void OmegaMesh::AddVertex(VertexId v, PointId p) {
+  if (point_of_.size() <= v.value()) {
+    point_of_.resize(v.value() + 1);
+    cell_gen_.resize(v.value() + 1, 0);
+    skinny_event_.resize(v.value() + 1);
+    unresolved_event_.resize(v.value() + 1);
+  }
+  point_of_[v.value()] = p;
+  ++cell_gen_[v.value()];
+}
+
+bool OmegaMesh::InsideCube(const Vec3& p) const {
+  // Coordinate comparisons are 1D orientation tests (predicates.h).
+  for (int k = 0; k < 3; ++k) {
+    if (geom::Orient1d(cube_.lo[k], p[k]) < 0 || geom::Orient1d(p[k], cube_.hi[k]) < 0) return false;
+  }
+  return true;
+}
+
+Vec3 OmegaMesh::FarPoint(TetId g) const {
+  // Ghost (a,b,c,∞): Orient3d(a,b,c,q) > 0 beyond the hull, so the outward
+  // normal is (b−a)×(c−a). The Voronoi edge dual to abc is the line through
+  // abc's circumcentre along that normal; a point 8 half-sides out is outside
+  // Ω, and so is the chord between two such points (docs/svrc-design.md §3).
+  const Vec3& a = dt_.Point(dt_.TetVertex(g, 0));
+  const Vec3& b = dt_.Point(dt_.TetVertex(g, 1));
+  const Vec3& c = dt_.Point(dt_.TetVertex(g, 2));
+  const Vec3 n = geom::Cross(b - a, c - a);
+  Vec3 m;
+  double r;
+  TriangleCircumball(a, b, c, &m, &r);
+  return m + (8.0 * half_side_ / geom::Norm(n)) * n;
+}
+
+void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* scratch) const {
+  // Sutherland–Hodgman against lo_k <= x_k and x_k <= hi_k. Intersection
+  // points get the plane's coordinate exactly, so corners on ∂Ω are on ∂Ω.
+  for (int k = 0; k < 3 && !poly->empty(); ++k) {
+    for (int side = 0; side < 2 && !poly->empty(); ++side) {
+      const double bound = side == 0 ? cube_.lo[k] : cube_.hi[k];
+      auto inside = [&](const Vec3& p) {
+        return side == 0 ? geom::Orient1d(bound, p[k]) >= 0 : geom::Orient1d(p[k], bound) >= 0;
+      };
+      scratch->clear();
+      const size_t n = poly->size();
+      for (size_t i = 0; i < n; ++i) {
+        const Vec3& a = (*poly)[i];
+        const Vec3& b = (*poly)[(i + 1) % n];
+        const bool ia = inside(a), ib = inside(b);
+        if (ia) scratch->push_back(a);
+        if (ia != ib) {
+          const double s = (bound - a[k]) / (b[k] - a[k]);
+          Vec3 q = a + s * (b - a);
+          q[k] = bound;
+          scratch->push_back(q);
+        }
+      }
+      poly->swap(*scratch);
+    }
+  }
+}
+
+CellSize OmegaMesh::Size(VertexId v) const {
+  ++stats_.size_queries;
+  CellSize out;
+  const Vec3& pv = dt_.Point(v);
+  out.inradius = dt_.InRadius(v);
+  out.hint = dt_.VertexTet(v);
+  dt_.Star(v, &star_);
+  bool needs_clip = false;
+  double best = -1;
+  for (TetId t : star_) {
+    if (dt_.IsGhost(t)) {
+      needs_clip = true;
+      break;
+    }
+    const Vec3 cc = dt_.Circumcenter(t);
+    if (!InsideCube(cc)) {
+      needs_clip = true;
+      break;
+    }
+    const double d = geom::Dist(cc, pv);
+    if (d > best) {
+      best = d;
+      out.corner = cc;
+      out.hint = t;
+    }
+  }
+  if (!needs_clip) {
+    out.outradius = best;
+    return out;
+  }
+  // Clip every Voronoi facet of v (dual to edge vu) to the cube.
+  ++stats_.clipped_queries;
+  out.clipped = true;
+  out.hint = dt_.VertexTet(v);
+  best = -1;
+  dt_.Neighbors(v, &nbrs_);
+  for (VertexId u : nbrs_) {
+    // The ring of tets around edge vu, walked across the faces containing vu.
+    TetId t0;
+    for (TetId t : star_) {
+      for (int i = 0; i < 4; ++i) {
+        if (dt_.TetVertex(t, i) == u) t0 = t;
+      }
+      if (t0.valid()) break;
+    }
+    if (!t0.valid()) continue;
+    poly_.clear();
+    TetId t = t0, prev;
+    for (int guard = 0; guard < 1024; ++guard) {
+      if (dt_.IsGhost(t)) {
+        poly_.push_back(FarPoint(t));
+      } else {
+        poly_.push_back(dt_.Circumcenter(t));
+      }
+      // The two faces of t containing v and u are opposite its other two vertices.
+      TetId next;
+      for (int i = 0; i < 4; ++i) {
+        const VertexId w = dt_.TetVertex(t, i);
+        if (w == v || w == u) continue;
+        const TetId n = dt_.Neighbor(t, i);
+        if (n != prev) {
+          next = n;
+          break;
+        }
+      }
+      prev = t;
+      t = next;
+      if (t == t0 || !t.valid()) break;
+    }
+    ClipPolygonToCube(&poly_, &poly2_);
+    for (const Vec3& x : poly_) {
+      const double d = geom::Dist(x, pv);
+      if (d > best) {
+        best = d;
+        out.corner = x;
+      }
+    }
+  }
+  out.outradius = best < 0 ? 0 : best;
+  return out;
+}
+
+}  // namespace svrc::refine

@@ -1,0 +1,97 @@
+// Feature meshes of SVRC (thesis §3.1, §3.2.1): M_Ω, the 3D Delaunay/Voronoi
+// mesh of a bounding cube Ω (Definition 35) seeded with its 8 corners, with
+// Voronoi cells clipped to Ω (Definition 11; docs/svrc-design.md §3), per-cell
+// generations (stale-event test) and the per-cell event handles ForceInsert
+// refreshes with DecreaseSize (Figure 3.5). The 1D/2D meshes come with stage (b)/(c).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/delaunay/delaunay3.h"
+#include "core/geometry/vec3.h"
+#include "core/svrc/ids.h"
+#include "core/svrc/work_queue.h"
+
+namespace svrc::refine {
+
+using delaunay::TetId;
+using delaunay::VertexId;
+
+// R_v of a cell clipped to Ω, the corner achieving it, and a tet near that
+// corner (a hint for Bowyer–Watson: the tet whose circumcentre it is when the
+// corner is a Voronoi vertex inside Ω).
+struct CellSize {
+  double outradius = 0;   // R_v (clipped)
+  double inradius = 0;    // r_v = half the shortest incident edge (Lemma 3)
+  geom::Vec3 corner;      // farthest corner of V(v) ∩ Ω
+  TetId hint;
+  bool clipped = false;   // the cell reached ∂Ω or infinity and was clipped
+};
+
+class OmegaMesh {
+ public:
+  // Ω = the axis-aligned cube with this centre and half side.
+  OmegaMesh(const geom::Vec3& center, double half_side);
+
+  const geom::Box3& cube() const { return cube_; }
+  geom::Vec3 Corner(int i) const;  // i in [0, 8): bit k selects hi on axis k
+
+  // Inserts the 8 corners with the given global point ids (SoS priorities).
+  void SeedCorners(const std::array<PointId, 8>& ids);
+
+  delaunay::Delaunay3& dt() { return dt_; }
+  const delaunay::Delaunay3& dt() const { return dt_; }
+
+  // Registers a vertex returned by dt().Insert: its global point and a fresh
+  // cell generation.
+  void AddVertex(VertexId v, PointId p);
+  PointId PointOf(VertexId v) const { return point_of_[v.value()]; }
+  uint32_t NumVertices() const { return static_cast<uint32_t>(point_of_.size()); }
+
+  // The cell of v changed (Figure 3.5's 𝒱'): its generation moves on.
+  void BumpCell(VertexId v) { ++cell_gen_[v.value()]; }
+  uint32_t CellGeneration(VertexId v) const { return cell_gen_[v.value()]; }
+
+  // R_v, r_v and the farthest corner of V(v) ∩ Ω. Cells whose incident tets
+  // are all finite with circumcentres in Ω use the circumcentres directly;
+  // the others clip each Voronoi facet (dual of an edge vu: the ring of
+  // circumcentres around vu, rays of hull faces replaced by far points) to the
+  // cube (Sutherland–Hodgman). Corners created on a cube face get that face's
+  // coordinate exactly, so they lie on ∂Ω.
+  CellSize Size(VertexId v) const;
+
+  // Per-cell handles of queued events (Figure 3.5: "if v' is the centre of
+  // some work event, DecreaseSize it").
+  EventHandle& SkinnyEvent(VertexId v) { return skinny_event_[v.value()]; }
+  EventHandle& UnresolvedEvent(VertexId v) { return unresolved_event_[v.value()]; }
+
+  struct Stats {
+    uint64_t size_queries = 0;
+    uint64_t clipped_queries = 0;
+  };
+  const Stats& stats() const { return stats_; }
+
+ private:
+  bool InsideCube(const geom::Vec3& p) const;
+  // Appends the polygon clipped to the cube to `out` (vertices only).
+  void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
+  // A far point on the Voronoi ray of ghost tet g (outside Ω).
+  geom::Vec3 FarPoint(TetId ghost) const;
+
+  geom::Box3 cube_;
+  double half_side_ = 0;
+  delaunay::Delaunay3 dt_;
+  std::vector<PointId> point_of_;
+  std::vector<uint32_t> cell_gen_;
+  std::vector<EventHandle> skinny_event_;
+  std::vector<EventHandle> unresolved_event_;
+  mutable Stats stats_;
+  // Scratch.
+  mutable std::vector<TetId> star_;
+  mutable std::vector<VertexId> nbrs_;
+  mutable std::vector<geom::Vec3> poly_, poly2_;
+};
+
+}  // namespace svrc::refine

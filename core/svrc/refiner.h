@@ -1,0 +1,94 @@
+// The SVRC refiner (thesis §3.3): main loop (Figure 3.2), Initialize (3.3),
+// Destroy (3.4: warp, else yield, else insert the centre), ForceInsert (3.5),
+// UpdateLocation (3.6) and PropagateLocation (3.9), with the corrections of the
+// implementer's guide §3. This is stage (a) of the guide's build plan: M_Ω and
+// the input points as 0-dimensional features (point-set SVR); segments and
+// facets come with stages (b)–(c). Decisions: docs/svrc-design.md.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/geometry/vec3.h"
+#include "core/mesh/tet_mesh.h"
+
+namespace svrc::refine {
+
+struct RefineOptions {
+  // Voronoi aspect-ratio bound τ (R_v/r_v ≤ τ at the end); the API's
+  // radius_edge is τ/2 (docs/svrc-design.md §4).
+  double tau = 4.0;
+  // Warp radius factor θ (§3.1.1).
+  double theta = 0.9;
+  // Vertex budget of M_Ω (corners, inputs and Steiner points); 0: derived,
+  // max(10^6, 1000·n). Exceeding it returns RESOURCE_EXHAUSTED.
+  uint64_t max_vertices = 0;
+  // Polled every `poll_interval` insertions (cancellation/deadline); a non-OK
+  // status aborts the run and is returned. May be null.
+  std::function<absl::Status()> poll;
+  uint32_t poll_interval = 256;
+  // > 0: check the stage-(a) invariants (guide §6 (a)) every that many
+  // insertions, and always at the end. For tests; costs O(n·m) per check.
+  uint32_t validate_every = 0;
+};
+
+// Run statistics (thesis ch. 5 quantities; guide §7 "measure per run").
+struct RefineStats {
+  uint64_t vertices = 0;           // in M_Ω at the end (corners included)
+  uint64_t input_vertices = 0;     // (dimension 0)
+  uint64_t steiner_vertices = 0;   // created in M_Ω (dimension 3), corners excluded
+  uint64_t insertions = 0;
+  uint64_t warps = 0;              // Destroy line 6
+  uint64_t yields = 0;             // Destroy line 13
+  uint64_t duplicates = 0;         // warp targets equal to an existing vertex
+  std::array<uint64_t, 4> events_pushed{};   // by EventType
+  std::array<uint64_t, 4> events_popped{};
+  std::array<uint64_t, 4> events_stale{};
+  uint64_t destroy_cells_visited = 0;  // |𝒱| summed over Destroy calls
+  uint64_t max_destroy_cells = 0;
+  uint64_t buckets_walked = 0;
+  uint64_t max_bucket_walk = 0;
+  uint64_t links_added = 0;        // LW-events (Lemma 36)
+  uint64_t links_removed = 0;
+  uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
+  uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)
+  uint64_t predicate_calls = 0;
+  uint64_t predicate_exact = 0;    // filter failures → exact arithmetic
+  uint64_t predicate_sos = 0;      // exact zero → symbolic perturbation
+  double max_aspect = 0;           // max R_v/r_v over cells at the end
+  double seconds = 0;
+
+  // Appends the counters to a MeshStats (names "svrc.*").
+  void ExportTo(mesh::MeshStats* out) const;
+};
+
+struct PointSetRefinement {
+  // Input points first, bit-exact and in input order, then the 8 corners of Ω,
+  // then Steiner points in creation order (input coordinates).
+  std::vector<geom::Vec3> positions;
+  uint32_t num_input = 0;
+  // Tets of M_Ω over `positions`, positively oriented in normalised
+  // coordinates (Delaunay3's invariant), in Delaunay3 slot order.
+  std::vector<std::array<uint32_t, 4>> tets;
+  // Per input point: the position index of the mesh vertex it became (itself,
+  // or an earlier point with identical coordinates).
+  std::vector<uint32_t> input_vertex;
+  // Ω in input coordinates.
+  geom::Box3 omega;
+  RefineStats stats;
+};
+
+// Point-set SVR inside SVRC's machinery (guide §6 stage (a)): refines M_Ω until
+// every input point is a vertex and every cell has R_v/r_v ≤ τ. Errors:
+// INVALID_ARGUMENT (no points, non-finite), RESOURCE_EXHAUSTED (budget),
+// the poll status (CANCELLED, DEADLINE_EXCEEDED), INTERNAL (an invariant
+// check failed with validate_every > 0; message names it).
+absl::StatusOr<PointSetRefinement> RefinePointSet(std::span<const geom::Vec3> points,
+                                                  const RefineOptions& options);
+
+}  // namespace svrc::refine
