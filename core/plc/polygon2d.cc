@@ -237,6 +237,134 @@ bool TriangulatePolygon(const std::vector<Vec3>& pts, const std::vector<uint32_t
   return EarClip(pr, poly, triangles);
 }
 
+namespace {
+
+bool HasVertex(const std::array<uint32_t, 3>& t, uint32_t v) {
+  return t[0] == v || t[1] == v || t[2] == v;
+}
+
+bool InsertPoint(const Proj& pr, uint32_t p, std::vector<std::array<uint32_t, 3>>& tris) {
+  for (const auto& t : tris) {
+    if (HasVertex(t, p)) return true;
+  }
+  for (size_t i = 0; i < tris.size(); ++i) {
+    const auto t = tris[i];
+    int o[3];
+    for (int k = 0; k < 3; ++k) o[k] = pr.O(t[k], t[(k + 1) % 3], p);  // edge k = t[k] t[k+1]
+    if (o[0] < 0 || o[1] < 0 || o[2] < 0) continue;
+    int zero = -1, nz = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (o[k] == 0) {
+        zero = k;
+        ++nz;
+      }
+    }
+    if (nz > 1) return false;  // coincides with a vertex (excluded above): degenerate
+    if (nz == 0) {
+      tris[i] = {t[0], t[1], p};
+      tris.push_back({t[1], t[2], p});
+      tris.push_back({t[2], t[0], p});
+      return true;
+    }
+    // On edge (a, b) = (t[zero], t[zero+1]); c opposite.
+    const uint32_t a = t[zero], b = t[(zero + 1) % 3], c = t[(zero + 2) % 3];
+    tris[i] = {a, p, c};
+    tris.push_back({p, b, c});
+    for (size_t j = 0; j < tris.size(); ++j) {
+      const auto u = tris[j];
+      for (int k = 0; k < 3; ++k) {
+        if (u[k] == b && u[(k + 1) % 3] == a) {
+          const uint32_t x = u[(k + 2) % 3];
+          tris[j] = {b, p, x};
+          tris.push_back({p, a, x});
+          return true;
+        }
+      }
+    }
+    return true;  // a boundary edge
+  }
+  return false;
+}
+
+bool InsertSegment(const Proj& pr, uint32_t a, uint32_t b, std::vector<std::array<uint32_t, 3>>& tris) {
+  for (const auto& t : tris) {
+    if (HasVertex(t, a) && HasVertex(t, b)) return true;  // already an edge
+  }
+  // Cavity: triangles with an edge properly crossed by ab.
+  auto crosses = [&](uint32_t u, uint32_t v) {
+    if (u == a || u == b || v == a || v == b) return false;
+    return pr.O(a, b, u) * pr.O(a, b, v) < 0 && pr.O(u, v, a) * pr.O(u, v, b) < 0;
+  };
+  std::vector<std::array<uint32_t, 3>> keep, cavity;
+  for (const auto& t : tris) {
+    bool c = false;
+    for (int k = 0; k < 3 && !c; ++k) c = crosses(t[k], t[(k + 1) % 3]);
+    (c ? cavity : keep).push_back(t);
+  }
+  if (cavity.empty()) return false;
+  // Boundary edges of the cavity (counter-clockwise), chained from a.
+  std::vector<std::pair<uint32_t, uint32_t>> bnd;
+  for (const auto& t : cavity) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t u = t[k], v = t[(k + 1) % 3];
+      bool inner = false;
+      for (const auto& s : cavity) {
+        for (int m = 0; m < 3; ++m) inner |= s[m] == v && s[(m + 1) % 3] == u;
+      }
+      if (!inner) bnd.push_back({u, v});
+    }
+  }
+  std::vector<uint32_t> loop{a};
+  for (size_t guard = 0; guard <= bnd.size(); ++guard) {
+    uint32_t next = UINT32_MAX;
+    int found = 0;
+    for (const auto& [u, v] : bnd) {
+      if (u == loop.back()) {
+        next = v;
+        ++found;
+      }
+    }
+    if (found != 1) return false;
+    if (next == a) break;
+    loop.push_back(next);
+  }
+  if (loop.size() != bnd.size()) return false;
+  const auto bpos = std::find(loop.begin(), loop.end(), b);
+  if (bpos == loop.end()) return false;
+  // Two polygons: a .. b (one side) and b .. a (the other), each closed by ab.
+  std::vector<uint32_t> left(loop.begin(), bpos + 1);
+  std::vector<uint32_t> right(bpos, loop.end());
+  right.push_back(a);
+  std::vector<std::array<uint32_t, 3>> out;
+  for (auto* poly : {&left, &right}) {
+    if (poly->size() < 3) return false;
+    std::vector<std::array<uint32_t, 3>> part;
+    if (!TriangulatePolygon(pr.pts, *poly, {}, pr.drop, &part)) return false;
+    out.insert(out.end(), part.begin(), part.end());
+  }
+  keep.insert(keep.end(), out.begin(), out.end());
+  tris.swap(keep);
+  return true;
+}
+
+}  // namespace
+
+bool InsertConstraints(const std::vector<Vec3>& pts, int drop, const std::vector<uint32_t>& points,
+                       const std::vector<std::array<uint32_t, 2>>& segments,
+                       std::vector<std::array<uint32_t, 3>>* triangles) {
+  const Proj pr{pts, drop};
+  for (uint32_t p : points) {
+    if (!InsertPoint(pr, p, *triangles)) return false;
+  }
+  for (const auto& s : segments) {
+    if (!InsertPoint(pr, s[0], *triangles) || !InsertPoint(pr, s[1], *triangles)) return false;
+  }
+  for (const auto& s : segments) {
+    if (!InsertSegment(pr, s[0], s[1], *triangles)) return false;
+  }
+  return true;
+}
+
 bool PointInsideLoop(const std::vector<Vec3>& pts, const std::vector<uint32_t>& loop, int drop,
                      Vec3* out) {
   std::vector<std::array<uint32_t, 3>> tris;

@@ -39,6 +39,16 @@ bool TriangulatePolygon(const std::vector<geom::Vec3>& pts, const std::vector<ui
                         const std::vector<std::vector<uint32_t>>& holes, int drop,
                         std::vector<std::array<uint32_t, 3>>* triangles);
 
+// Makes a triangulation from TriangulatePolygon (counter-clockwise in the
+// projection) contain the given points as vertices (split triangles) and the
+// given segments as edges (cavity retriangulation). Points must lie in the
+// triangulated region; no point may lie strictly inside a segment. Returns
+// false (triangles possibly partly updated) if a constraint cannot be inserted.
+bool InsertConstraints(const std::vector<geom::Vec3>& pts, int drop,
+                       const std::vector<uint32_t>& points,
+                       const std::vector<std::array<uint32_t, 2>>& segments,
+                       std::vector<std::array<uint32_t, 3>>* triangles);
+
 // One point strictly inside a simple loop (centroid of an ear); false if none.
 bool PointInsideLoop(const std::vector<geom::Vec3>& pts, const std::vector<uint32_t>& loop,
                      int drop, geom::Vec3* out);

@@ -575,6 +575,19 @@ class Preparer {
         }
         ok = TriangulatePolygon(P_, ff.loops[l], holes, w.drop, &ff.triangles);
       }
+      // In-facet segments and edges of in-facet polygons become triangle edges.
+      if (ok) {
+        std::vector<std::array<uint32_t, 2>> cons;
+        for (SegmentId sid : ff.segments) {
+          for (const Owner& o : piece_owners_[sid]) {
+            if (o.facet == f && (o.loop < 0 || w.two_sided[o.loop])) {
+              cons.push_back({fc_.segments[sid].a, fc_.segments[sid].b});
+              break;
+            }
+          }
+        }
+        if (!cons.empty()) ok = InsertConstraints(P_, w.drop, {}, cons, &ff.triangles);
+      }
       if (!ok) {
         w.ok = false;
         ff.triangles.clear();
@@ -630,6 +643,15 @@ class Preparer {
             fc_.facets[f].interior_points.push_back(p);
           }
         }
+      }
+    }
+    for (uint32_t f = 0; f < fc_.facets.size(); ++f) {
+      FeatureFacet& ff = fc_.facets[f];
+      if (ff.interior_points.empty()) continue;
+      std::sort(ff.interior_points.begin(), ff.interior_points.end());
+      if (!InsertConstraints(P_, work_[f].drop, ff.interior_points, {}, &ff.triangles)) {
+        Error(ProblemKind::kUntriangulable, Cat(FacetName(f), ": cannot insert its interior points"), {f}, FacetLine(f));
+        work_[f].ok = false;
       }
     }
     for (PointId p = 0; p < P_.size(); ++p) {

@@ -242,7 +242,7 @@ absl::Status ReadObj(std::string_view bytes, const std::string& name, SurfaceSou
       if (r.Remaining() < 3) return r.Error(Cat("face with ", r.Remaining(), " vertices"));
       std::vector<uint32_t> face;
       while (r.Remaining() > 0) {
-        uint32_t idx;
+        uint32_t idx = 0;
         if (absl::Status s = vertex_ref(r.Take(), &idx); !s.ok()) return s;
         face.push_back(idx);
       }
@@ -252,10 +252,10 @@ absl::Status ReadObj(std::string_view bytes, const std::string& name, SurfaceSou
       ++face_count;
     } else if (kw == "l") {
       if (r.Remaining() < 2) return r.Error("line element with fewer than 2 vertices");
-      uint32_t prev;
+      uint32_t prev = 0;
       if (absl::Status s = vertex_ref(r.Take(), &prev); !s.ok()) return s;
       while (r.Remaining() > 0) {
-        uint32_t idx;
+        uint32_t idx = 0;
         if (absl::Status s = vertex_ref(r.Take(), &idx); !s.ok()) return s;
         soup->segments.push_back({prev, idx, marker});
         prev = idx;

@@ -96,7 +96,7 @@ absl::Status ReadPolygon(LineReader& r, Plc* plc, size_t facet, size_t polygon, 
   for (int64_t i = 0; i < k; ++i) {
     int64_t v = 0;
     if (absl::Status s = r.NextInt("a polygon corner", &v); !s.ok()) return s;
-    uint32_t idx;
+    uint32_t idx = 0;
     if (absl::Status s = VertexIndex(r, *plc, v, facet, polygon, &idx); !s.ok()) return s;
     poly->vertices.push_back(idx);
   }

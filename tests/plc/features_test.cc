@@ -1,0 +1,246 @@
+// Feature complex: points/segments/facets, splitting, creases (thesis
+// Definitions 4-5) on hand-built PLCs and corpus files, and the spread Δ.
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/plc/features.h"
+#include "core/plc/readers.h"
+#include "core/plc/validate.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "tests/test_support.h"
+
+namespace svrc::plc {
+namespace {
+
+using ::testing::ElementsAre;
+using svrc::testing::CorpusPath;
+
+constexpr double kDeg = std::numbers::pi / 180;
+
+FeatureComplex MustBuild(const Plc& plc) {
+  absl::StatusOr<FeatureComplex> fc = BuildFeatureComplex(plc);
+  EXPECT_TRUE(fc.ok()) << fc.status();
+  return fc.ok() ? *std::move(fc) : FeatureComplex{};
+}
+
+FeatureComplex MustBuildFile(const std::string& rel) {
+  absl::StatusOr<Plc> plc = ReadPlcFile(CorpusPath(rel));
+  EXPECT_TRUE(plc.ok()) << plc.status();
+  return plc.ok() ? MustBuild(*plc) : FeatureComplex{};
+}
+
+Facet Quad(uint32_t a, uint32_t b, uint32_t c, uint32_t d, int32_t m = 0) {
+  Facet f;
+  f.polygons.push_back(Polygon{{a, b, c, d}});
+  f.marker = m;
+  return f;
+}
+Facet Tri(uint32_t a, uint32_t b, uint32_t c) {
+  Facet f;
+  f.polygons.push_back(Polygon{{a, b, c}});
+  return f;
+}
+
+// A closed triangular prism whose two slanted faces meet along the edge at
+// (0, y, 0) with the given opening angle; y in [0, 1].
+Plc Wedge(double angle_deg) {
+  const double a = angle_deg * kDeg;
+  Plc plc;
+  plc.vertices = {{0, 0, 0}, {1, 0, 0}, {std::cos(a), 0, std::sin(a)},
+                  {0, 1, 0}, {1, 1, 0}, {std::cos(a), 1, std::sin(a)}};
+  plc.facets = {Tri(0, 1, 2), Tri(3, 4, 5), Quad(0, 1, 4, 3), Quad(0, 2, 5, 3), Quad(1, 2, 5, 4)};
+  return plc;
+}
+
+TEST(Features, CubeHasNoCreases) {
+  for (const char* rel : {"a_convex/cube.poly", "a_convex/cube_binary.stl"}) {
+    SCOPED_TRACE(rel);
+    const FeatureComplex fc = MustBuildFile(rel);
+    EXPECT_EQ(fc.points.size(), 8u);
+    EXPECT_EQ(fc.segments.size(), 12u);
+    EXPECT_EQ(fc.facets.size(), 6u);
+    EXPECT_EQ(fc.NumCreasePoints(), 0u);
+    EXPECT_EQ(fc.NumCreaseSegments(), 0u);
+    for (const FeatureSegment& s : fc.segments) {
+      EXPECT_EQ(s.facets.size(), 2u);
+      EXPECT_NEAR(s.min_angle, 90 * kDeg, 1e-12);
+    }
+    for (const FeatureFacet& f : fc.facets) {
+      EXPECT_EQ(f.triangles.size(), 2u);
+      EXPECT_NEAR(std::fabs(f.frame.normal.x) + std::fabs(f.frame.normal.y) + std::fabs(f.frame.normal.z), 1, 1e-15);
+      EXPECT_NEAR(geom::Dot(f.frame.u, f.frame.v), 0, 1e-15);
+    }
+    EXPECT_NEAR(fc.spread, std::sqrt(3.0), 1e-12);
+  }
+}
+
+TEST(Features, WedgeAt30DegreesIsACrease) {
+  const FeatureComplex fc = MustBuild(Wedge(30));
+  const SegmentId edge = fc.FindSegment(0, 3);
+  ASSERT_NE(edge, kNoId);
+  EXPECT_TRUE(fc.segments[edge].crease);
+  EXPECT_NEAR(fc.segments[edge].min_angle, 30 * kDeg, 1e-12);
+  EXPECT_TRUE(fc.points[0].crease);
+  EXPECT_TRUE(fc.points[3].crease);
+  // The 90° edges (bottom face against the end triangles) are not creases...
+  EXPECT_FALSE(fc.segments[fc.FindSegment(0, 1)].crease);
+  // ...but the 75° edge at the top of the wedge is.
+  EXPECT_TRUE(fc.segments[fc.FindSegment(2, 5)].crease);
+  // A 100° wedge: the ridge is no crease.
+  const FeatureComplex wide = MustBuild(Wedge(100));
+  EXPECT_FALSE(wide.segments[wide.FindSegment(0, 3)].crease);
+  EXPECT_NEAR(wide.segments[wide.FindSegment(0, 3)].min_angle, 100 * kDeg, 1e-12);
+}
+
+TEST(Features, ThreeFacetsAt120DegreesAroundAnEdge) {
+  // Three rectangles sharing the edge from (0,0,0) to (0,1,0), 120° apart.
+  Plc plc;
+  plc.vertices = {{0, 0, 0}, {0, 1, 0}};
+  for (int k = 0; k < 3; ++k) {
+    const double a = k * 120 * kDeg;
+    plc.vertices.push_back({std::cos(a), 0, std::sin(a)});
+    plc.vertices.push_back({std::cos(a), 1, std::sin(a)});
+    plc.facets.push_back(Quad(0, 2 + 2 * k, 3 + 2 * k, 1));
+  }
+  ValidationOptions vo;
+  FeatureOptions fo;
+  ValidationReport report;
+  absl::StatusOr<FeatureComplex> fc = PreparePlc(plc, vo, fo, &report);
+  // Open (fins only): rejected by the closedness rule, so measure the angles
+  // on the complex built without that rule's verdict: validate the closed
+  // variant below, and check the angle here through a closed prism set.
+  EXPECT_FALSE(fc.ok());
+  // Close it: add the three outer faces and end caps (triangles split by the
+  // spokes), making three 120° prisms around the shared edge.
+  for (int k = 0; k < 3; ++k) {
+    const int j = (k + 1) % 3;
+    plc.facets.push_back(Quad(2 + 2 * k, 2 + 2 * j, 3 + 2 * j, 3 + 2 * k));
+    plc.facets.push_back(Tri(0, 2 + 2 * k, 2 + 2 * j));
+    plc.facets.push_back(Tri(1, 3 + 2 * k, 3 + 2 * j));
+  }
+  fc = PreparePlc(plc, vo, fo, &report);
+  ASSERT_TRUE(fc.ok()) << fc.status();
+  const SegmentId axis = fc->FindSegment(0, 1);
+  ASSERT_NE(axis, kNoId);
+  EXPECT_EQ(fc->segments[axis].facets.size(), 3u);
+  EXPECT_NEAR(fc->segments[axis].min_angle, 120 * kDeg, 1e-12);
+  EXPECT_FALSE(fc->segments[axis].crease);
+}
+
+TEST(Features, Wedge1SmeshAndKnifeEdge) {
+  const FeatureComplex w = MustBuildFile("c_creases/wedge-1.smesh");
+  const SegmentId ridge = w.FindSegment(0, 1);
+  ASSERT_NE(ridge, kNoId);
+  EXPECT_TRUE(w.segments[ridge].crease);
+  // The file lifts the edge by sin(1°) over a run of 1: atan(sin 1°) = 0.99985°.
+  EXPECT_NEAR(w.segments[ridge].min_angle, std::atan(std::sin(1 * kDeg)), 1e-12);
+  EXPECT_TRUE(w.points[0].crease && w.points[1].crease);
+  // The 89° edge between the slanted top and the end face is a crease too;
+  // the 90° ones are not.
+  EXPECT_TRUE(w.segments[w.FindSegment(4, 5)].crease);
+  EXPECT_FALSE(w.segments[w.FindSegment(2, 3)].crease);
+
+  const FeatureComplex k = MustBuildFile("c_creases/knife_edge.poly");
+  const SegmentId blade = k.FindSegment(12, 13);
+  ASSERT_NE(blade, kNoId);
+  EXPECT_TRUE(k.segments[blade].crease);
+  EXPECT_NEAR(k.segments[blade].min_angle, 5 * kDeg, 1e-9);
+  EXPECT_EQ(k.NumCreaseSegments(), 1u);
+  EXPECT_EQ(k.NumCreasePoints(), 2u);
+}
+
+TEST(Features, SegmentsSplitAtPointsOnThemAndFreeSegments) {
+  const FeatureComplex fan = MustBuildFile("d_small_angles/segment_fan.poly");
+  // In-facet segments of the top facet from corner 5 (0-based 4) fan out at
+  // 0.5..8 degrees: crease points; their pieces lie in the top facet only.
+  EXPECT_TRUE(fan.points[4].crease);
+  const SegmentId s = fan.FindSegment(4, 8);
+  ASSERT_NE(s, kNoId);
+  EXPECT_THAT(fan.segments[s].facets, ElementsAre(1));
+  // The two free segments meet at 1 degree at point 17 (0-based 16).
+  EXPECT_TRUE(fan.points[16].crease);
+  ASSERT_EQ(fan.pieces_of_free_segment.size(), 2u);
+  EXPECT_TRUE(fan.segments[fan.pieces_of_free_segment[0][0]].is_free);
+
+  // A vertical free segment standing on the midpoint of a square's edge
+  // splits that edge; its other end is an interior point of nothing.
+  Plc plc;
+  plc.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0, 0}, {0.5, 0, 1},
+                  {0.5, 0.5, 0}};
+  plc.facets = {Quad(0, 1, 2, 3)};
+  plc.segments = {{4, 5, 7}};
+  ValidationReport report;
+  absl::StatusOr<FeatureComplex> fc = PreparePlc(plc, {}, {}, &report);
+  // Not closed (a lone square): the complex is still checked via validation.
+  EXPECT_FALSE(fc.ok());
+  ASSERT_NE(report.Find(ProblemKind::kOpenBoundary), nullptr);
+  EXPECT_EQ(report.errors.size(), 1u);
+}
+
+TEST(Features, SplitAndInteriorPointsInAClosedBox) {
+  Plc plc;
+  plc.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                  {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1},
+                  {0.5, 0, 0}, {0.5, 0.5, 0.5}, {0.3, 0.4, 0}};
+  plc.facets = {Quad(0, 3, 2, 1), Quad(4, 5, 6, 7), Quad(0, 1, 5, 4),
+                Quad(1, 2, 6, 5), Quad(2, 3, 7, 6), Quad(3, 0, 4, 7)};
+  plc.segments = {{8, 9, 4}, {10, 9, 5}};  // one on the bottom edge midpoint, one from a bottom interior point
+  const FeatureComplex fc = MustBuild(plc);
+  EXPECT_EQ(fc.points.size(), 11u);
+  // Edge 0-1 split at 8 on both the bottom and the front face.
+  EXPECT_EQ(fc.FindSegment(0, 1), kNoId);
+  const SegmentId a = fc.FindSegment(0, 8), b = fc.FindSegment(1, 8);
+  ASSERT_NE(a, kNoId);
+  ASSERT_NE(b, kNoId);
+  EXPECT_THAT(fc.segments[a].facets, ElementsAre(0, 2));
+  EXPECT_EQ(fc.facets[0].loops[0].size(), 5u);
+  // Point 10 lies inside the bottom facet.
+  EXPECT_THAT(fc.points[10].interior_of, ElementsAre(0));
+  EXPECT_THAT(fc.facets[0].interior_points, ElementsAre(10));
+  EXPECT_FALSE(fc.points[10].isolated);
+  const SegmentId free = fc.FindSegment(9, 10);
+  ASSERT_NE(free, kNoId);
+  EXPECT_TRUE(fc.segments[free].is_free);
+  EXPECT_EQ(fc.segments[free].marker, 5);
+  EXPECT_TRUE(fc.segments[free].facets.empty());
+  // Point 9 is where two free segments meet at an acute angle.
+  EXPECT_TRUE(fc.points[9].crease);
+}
+
+TEST(Features, Spread) {
+  const FeatureComplex far = MustBuildFile("e_spread/far_offset_close_points.poly");
+  // Two isolated points 1e-3 apart and 1e-3 above the bottom facet.
+  EXPECT_NEAR(far.min_feature_distance, 1e-3, 1e-9);
+  EXPECT_NEAR(far.diameter, 1000 * std::sqrt(3.0), 1e-6);
+  EXPECT_NEAR(far.spread, std::sqrt(3.0) * 1e6, 10);
+  EXPECT_EQ(far.points[8].isolated, true);
+  const FeatureComplex tiny = MustBuildFile("e_spread/tiny_cube_in_box.poly");
+  EXPECT_NEAR(tiny.min_feature_distance, 1e-4, 1e-12);
+  EXPECT_NEAR(tiny.spread, std::sqrt(3.0) * 1e4, 1e-3);
+  // box_in_box: isolated point (0.1, 0.1, 0.1) is 0.1 from three faces.
+  const FeatureComplex bb = MustBuildFile("b_internal/box_in_box.poly");
+  EXPECT_NEAR(bb.min_feature_distance, 0.1, 1e-12);
+}
+
+TEST(Features, ExampleHoleAndRegions) {
+  const FeatureComplex ex = MustBuildFile("b_internal/example.poly");
+  // Facet 3 has a hole loop (the inner box's face fills it with facet 20).
+  const FeatureFacet& f3 = ex.facets[2];
+  ASSERT_EQ(f3.loops.size(), 2u);
+  EXPECT_FALSE(f3.loop_is_hole[0]);
+  EXPECT_TRUE(f3.loop_is_hole[1]);
+  EXPECT_EQ(f3.triangles.size(), 8u);  // quad with a quad hole
+  EXPECT_EQ(ex.regions.size(), 2u);
+  EXPECT_EQ(ex.holes.size(), 2u);
+  // The slanted internal facet 2 meets the upper box walls at 63.4°.
+  EXPECT_EQ(ex.NumCreaseSegments(), 2u);
+  const SegmentId s = ex.FindSegment(6, 7);
+  ASSERT_NE(s, kNoId);
+  EXPECT_NEAR(ex.segments[s].min_angle, std::atan2(2, 1), 1e-12);
+}
+
+}  // namespace
+}  // namespace svrc::plc
