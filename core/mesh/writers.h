@@ -8,13 +8,16 @@
 #include <string_view>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "core/mesh/tet_mesh.h"
 
 namespace svrc::mesh {
 
 enum class OutputFormat { kTetgen, kVtu, kMsh, kMedit };
 
-// By extension: .node (writes .node/.ele/.face beside it), .vtu, .msh, .mesh.
+// By extension (case-insensitive): .node (writes .node/.ele/.face beside it),
+// .vtu (writes <stem>.vtu with the tets and <stem>.boundary.vtu with the
+// boundary/interface triangles), .msh, .mesh.
 // (.svrc, the raw result container, is core/codec's.)
 absl::StatusOr<OutputFormat> OutputFormatFromPath(std::string_view path);
 
