@@ -1,6 +1,7 @@
 // Feature meshes (thesis §3.1–3.2): M_Ω with cells clipped to the cube Ω.
 #include "core/svrc/feature_meshes.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/geometry/predicates.h"
@@ -44,6 +45,20 @@ bool OmegaMesh::InsideCube(const Vec3& p) const {
     if (geom::Orient1d(cube_.lo[k], p[k]) < 0 || geom::Orient1d(p[k], cube_.hi[k]) < 0) return false;
   }
   return true;
+}
+
+const Vec3& OmegaMesh::CachedCircumcenter(TetId t) const {
+  const uint32_t i = t.value();
+  if (cc_.size() <= i) {
+    cc_.resize(dt_.TetCapacity() + 64);
+    cc_gen_.resize(dt_.TetCapacity() + 64, 0);
+  }
+  const uint32_t g = dt_.Generation(t) + 1;
+  if (cc_gen_[i] != g) {
+    cc_[i] = dt_.Circumcenter(t);
+    cc_gen_[i] = g;
+  }
+  return cc_[i];
 }
 
 Vec3 OmegaMesh::FarPoint(TetId g) const {
@@ -93,9 +108,19 @@ CellSize OmegaMesh::Size(VertexId v) const {
   ++stats_.size_queries;
   CellSize out;
   const Vec3& pv = dt_.Point(v);
-  out.inradius = dt_.InRadius(v);
   out.hint = dt_.VertexTet(v);
   dt_.Star(v, &star_);
+  // r_v = half the shortest Delaunay edge at v (Lemma 3), read off the star
+  // (one star walk instead of Delaunay3::InRadius' second one).
+  double shortest2 = HUGE_VAL;
+  for (TetId t : star_) {
+    for (int i = 0; i < 4; ++i) {
+      const VertexId w = dt_.TetVertex(t, i);
+      if (w == v || w == delaunay::kInfiniteVertex) continue;
+      shortest2 = std::min(shortest2, geom::Dist2(dt_.Point(w), pv));
+    }
+  }
+  out.inradius = 0.5 * std::sqrt(shortest2);
   bool needs_clip = false;
   double best = -1;
   for (TetId t : star_) {
@@ -103,7 +128,7 @@ CellSize OmegaMesh::Size(VertexId v) const {
       needs_clip = true;
       break;
     }
-    const Vec3 cc = dt_.Circumcenter(t);
+    const Vec3& cc = CachedCircumcenter(t);
     if (!InsideCube(cc)) {
       needs_clip = true;
       break;
@@ -141,7 +166,7 @@ CellSize OmegaMesh::Size(VertexId v) const {
       if (dt_.IsGhost(t)) {
         poly_.push_back(FarPoint(t));
       } else {
-        poly_.push_back(dt_.Circumcenter(t));
+        poly_.push_back(CachedCircumcenter(t));
       }
       // The two faces of t containing v and u are opposite its other two vertices.
       TetId next;

@@ -36,12 +36,20 @@ const LocationGraph::List* LocationGraph::FindObjectList(LocationObject object) 
 }
 
 uint32_t LocationGraph::Find(MeshId mesh, uint32_t cell, LocationObject object) const {
-  // Walk the cell's list: its length is bounded by the ply of the objects
-  // (Bounded-Ply Lemma 6), unlike an input object's list early in the run.
-  const List* list = FindCellList(mesh, cell);
-  if (list == nullptr) return kNil;
-  for (uint32_t l = list->head; l != kNil; l = links_[l].next_cell) {
-    if (links_[l].object == object) return l;
+  // Walk the shorter of the two lists: early in a run one cell can hold
+  // thousands of unresolved points, and an input object can be linked to many
+  // cells; the other list is then short (bounded ply, Lemma 6).
+  const List* cl = FindCellList(mesh, cell);
+  const List* ol = FindObjectList(object);
+  if (cl == nullptr || ol == nullptr) return kNil;
+  if (cl->size <= ol->size) {
+    for (uint32_t l = cl->head; l != kNil; l = links_[l].next_cell) {
+      if (links_[l].object == object) return l;
+    }
+  } else {
+    for (uint32_t l = ol->head; l != kNil; l = links_[l].next_obj) {
+      if (links_[l].cell == cell && links_[l].mesh == mesh) return l;
+    }
   }
   return kNil;
 }
@@ -72,10 +80,12 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   link.prev_cell = cl.tail;
   if (cl.tail != kNil) links_[cl.tail].next_cell = l; else cl.head = l;
   cl.tail = l;
+  ++cl.size;
   List& ol = ObjectList(object);
   link.prev_obj = ol.tail;
   if (ol.tail != kNil) links_[ol.tail].next_obj = l; else ol.head = l;
   ol.tail = l;
+  ++ol.size;
   ++num_links_;
   ++stats_.links_added;
   result.link = LinkId(l);
@@ -107,6 +117,8 @@ void LocationGraph::RemoveLink(LinkId id) {
   List& ol = ObjectList(link.object);
   if (link.prev_obj != kNil) links_[link.prev_obj].next_obj = link.next_obj; else ol.head = link.next_obj;
   if (link.next_obj != kNil) links_[link.next_obj].prev_obj = link.prev_obj; else ol.tail = link.prev_obj;
+  --cl.size;
+  --ol.size;
   if (link.unresolved) --unresolved_[link.mesh.value()][link.cell];
   link.cell = kNil;
   link.prev_cell = link.next_cell = link.prev_obj = kNil;

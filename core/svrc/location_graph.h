@@ -101,6 +101,7 @@ class LocationGraph {
   };
   struct List {
     uint32_t head = kNil, tail = kNil;
+    uint32_t size = 0;
   };
 
   List& CellList(MeshId mesh, uint32_t cell);

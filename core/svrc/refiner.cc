@@ -64,6 +64,10 @@ class PointSetRefiner {
   std::vector<uint32_t> duplicate_of_;  // first input point with the same coordinates
   RefineStats stats_;
   uint64_t budget_ = 0;
+  // The cell size computed by IsLive for the event Destroy gets next.
+  CellSize last_size_;
+  VertexId last_size_vertex_;
+  uint32_t last_size_gen_ = 0;
   // Scratch.
   std::vector<VertexId> bfs_, nbrs_;
   std::vector<uint32_t> mark_;
@@ -163,7 +167,10 @@ bool PointSetRefiner::IsLive(const WorkEvent& e) {
   const VertexId v(e.object);
   if (omega_.CellGeneration(v) != e.generation) return false;
   if (e.type == EventType::kUnresolved) return blg_.NumUnresolved(kOmegaMesh, v.value()) > 0;
-  if (e.type == EventType::kSkinny) return IsSkinny(omega_.Size(v));
+  last_size_ = omega_.Size(v);
+  last_size_vertex_ = v;
+  last_size_gen_ = omega_.CellGeneration(v);
+  if (e.type == EventType::kSkinny) return IsSkinny(last_size_);
   return true;
 }
 
@@ -199,7 +206,8 @@ absl::Status PointSetRefiner::Destroy(const WorkEvent& event) {
   // Line 1 (stale test) was done at Dequeue. The gap ball is rebuilt from the
   // cell now: ⟨(farthest corner of V(v) ∩ Ω, R_v), Ω⟩; CD(B) = CD(c) = (3,3).
   const VertexId v(event.object);
-  const CellSize s = omega_.Size(v);
+  const CellSize s = (last_size_vertex_ == v && last_size_gen_ == omega_.CellGeneration(v)) ? last_size_
+                                                                                             : omega_.Size(v);
   const Vec3 c = s.corner;
   const double r = s.outradius;
   const Cd cd_ball = kCdSpace;
@@ -209,10 +217,26 @@ absl::Status PointSetRefiner::Destroy(const WorkEvent& event) {
   // over Delaunay neighbours restricted to that conservative superset finds
   // every cell meeting B (they form a connected set) — guide §3 allows
   // conservative inflation for location.
-  const double reach = 3.0 * r * (1 + 1e-9);
+  // Filter: V(u) lies in the half-space of points nearer to u than to v, which
+  // meets B(c, r) only if the signed distance from c to the bisector of uv,
+  // (|uc|² − |vc|²) / (2|uv|), is at most r. The true set of cells meeting B
+  // is connected and inside this superset, so a BFS over it from v finds all
+  // of them (guide §3: conservative inflation is fine for location); the
+  // relative slack keeps rounding on the conservative side.
+  const Vec3& pv = omega_.dt().Point(v);
+  const double vc2 = geom::Dist2(pv, c);
+  auto may_meet = [&](const Vec3& pu) {
+    return geom::Dist2(pu, c) - vc2 <= 2.0 * r * geom::Dist(pu, pv) * (1 + 1e-9) + 1e-12 * vc2;
+  };
   ++stamp_;
   if (mark_.size() < omega_.NumVertices()) mark_.resize(omega_.NumVertices(), 0);
   bfs_.clear();
+  // No ball is linked to any cell of M_Ω: 𝓑 = ∅, so 𝒲 = 𝒴 = ∅ and the centre
+  // is inserted; skip the search.
+  if (blg_.NumLinks() == 0) {
+    const PointId p = points_.Add(c, FeatureTable::Omega(), kCdSpace);
+    return ForceInsert(p, s.hint);
+  }
   bfs_.push_back(v);
   mark_[v.value()] = stamp_;
   for (size_t i = 0; i < bfs_.size(); ++i) {
@@ -220,7 +244,7 @@ absl::Status PointSetRefiner::Destroy(const WorkEvent& event) {
     for (VertexId u : nbrs_) {
       if (mark_[u.value()] == stamp_) continue;
       mark_[u.value()] = stamp_;
-      if (geom::Dist(omega_.dt().Point(u), c) <= reach) bfs_.push_back(u);
+      if (may_meet(omega_.dt().Point(u))) bfs_.push_back(u);
     }
   }
   stats_.destroy_cells_visited += bfs_.size();
