@@ -50,8 +50,8 @@ struct QuantizationReport {
   uint64_t inverted_tets = 0;       // orientation sign flipped
 };
 
-// Compares `mesh` with its quantized positions `qp`. Orientation after
-// rounding is exact (integer determinant on the lattice indices).
+// Compares `mesh` with its quantized positions `qp`; orientations before and
+// after rounding are exact (geom::Orient3d). Tets already flat are not counted.
 QuantizationReport MeasureQuantization(const mesh::TetMesh& mesh, const QuantizedPositions& qp);
 
 }  // namespace svrc::codec

@@ -242,8 +242,8 @@ TEST(ContainerTest, RejectsInconsistentMeshes) {
 // tests/codec/data/reference_v1.svrc is the encoding of ReferenceMesh(). Any
 // change to the byte format (or to Draco's output) fails here; a deliberate
 // change bumps the format version and regenerates the file with
-//   SVRC_REGENERATE_CODEC_REFERENCE=1 build/<dir>/tests/codec/svrc_codec_tests \
-//     --gtest_filter='ReferenceContainer*'
+//   SVRC_REGENERATE_CODEC_REFERENCE=1 build/<dir>/tests/codec/svrc_codec_tests
+//       --gtest_filter='ReferenceContainer*'
 
 mesh::TetMesh ReferenceMesh() {
   GridMeshOptions o;
