@@ -13,10 +13,6 @@
 
 namespace svrc::geom {
 
-namespace internal {
-thread_local constinit PredicateStats tls_predicate_stats;
-}  // namespace internal
-
 namespace {
 
 using internal::SignOf;

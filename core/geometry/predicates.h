@@ -88,9 +88,10 @@ struct PredicateStats {
 };
 
 namespace internal {
-// Defined in predicates.cc. Trivial type with constant initialisation
-// (constinit), so access from other translation units is a plain TLS load.
-extern thread_local constinit PredicateStats tls_predicate_stats;
+// An inline variable (one definition, emitted where used) of a trivial type
+// with constant initialisation: every access is a plain TLS load, with no
+// cross-TU TLS wrapper call.
+inline thread_local constinit PredicateStats tls_predicate_stats;
 inline void CountCall(Pred p) { ++tls_predicate_stats.calls[static_cast<int>(p)]; }
 }  // namespace internal
 

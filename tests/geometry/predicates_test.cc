@@ -23,6 +23,15 @@ namespace {
 
 using Q = mpq_class;
 
+// Sanitizer builds (CI runs the `core` suites under ASan+UBSan) use a quarter
+// of the cases; release builds run them all.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_UNDEFINED__)
+constexpr int kCaseDivisor = 4;
+#else
+constexpr int kCaseDivisor = 1;
+#endif
+constexpr int N(int n) { return n / kCaseDivisor; }
+
 // ---------------------------------------------------------------- oracle
 
 // Determinant of an n×n rational matrix by Gaussian elimination.
@@ -214,9 +223,9 @@ TEST(PredicatesTest, Orient2dMatchesOracle) {
     ++cases;
     zeros += want == 0;
   };
-  for (int i = 0; i < 4000; ++i) check({g.Point2(), g.Point2(), g.Point2()});
+  for (int i = 0; i < N(4000); ++i) check({g.Point2(), g.Point2(), g.Point2()});
   for (const Frame& f : kFrames) {
-    for (int i = 0; i < 600; ++i) {
+    for (int i = 0; i < N(600); ++i) {
       // Collinear: a + s·(b−a) with small integers.
       const Vec2 a = g.IntPoint2(8), d = g.IntPoint2(3);
       const int s = g.Int(-3, 3), t = g.Int(-3, 3);
@@ -228,12 +237,12 @@ TEST(PredicatesTest, Orient2dMatchesOracle) {
     }
   }
   // Far from the origin with 1e-3 separations (not exactly representable).
-  for (int i = 0; i < 2000; ++i) {
+  for (int i = 0; i < N(2000); ++i) {
     const Vec2 o{1e6, -1e6};
     check({o + 1e-3 * g.IntPoint2(3), o + 1e-3 * g.IntPoint2(3), o + 1e-3 * g.IntPoint2(3)});
   }
-  EXPECT_GT(zeros, 1000);
-  EXPECT_GT(cases, 20000);
+  EXPECT_GT(zeros, N(1000));
+  EXPECT_GT(cases, N(20000));
 }
 
 TEST(PredicatesTest, Orient3dMatchesOracle) {
@@ -245,9 +254,9 @@ TEST(PredicatesTest, Orient3dMatchesOracle) {
     ++cases;
     zeros += want == 0;
   };
-  for (int i = 0; i < 4000; ++i) check({g.Point3(), g.Point3(), g.Point3(), g.Point3()});
+  for (int i = 0; i < N(4000); ++i) check({g.Point3(), g.Point3(), g.Point3(), g.Point3()});
   for (const Frame& f : kFrames) {
-    for (int i = 0; i < 500; ++i) {
+    for (int i = 0; i < N(500); ++i) {
       // Coplanar: a + s·u + t·v.
       const Vec3 a = g.IntPoint3(8), u = g.IntPoint3(3), v = g.IntPoint3(3);
       std::array<Vec3, 4> p;
@@ -259,13 +268,13 @@ TEST(PredicatesTest, Orient3dMatchesOracle) {
              Apply(f, g.IntPoint3(1))});
     }
   }
-  for (int i = 0; i < 2000; ++i) {
+  for (int i = 0; i < N(2000); ++i) {
     const Vec3 o{1e6, 1e6, -1e6};
     check({o + 1e-3 * g.IntPoint3(2), o + 1e-3 * g.IntPoint3(2), o + 1e-3 * g.IntPoint3(2),
            o + 1e-3 * g.IntPoint3(2)});
   }
-  EXPECT_GT(zeros, 1000);
-  EXPECT_GT(cases, 20000);
+  EXPECT_GT(zeros, N(1000));
+  EXPECT_GT(cases, N(20000));
 }
 
 TEST(PredicatesTest, InCircleMatchesOracle) {
@@ -277,11 +286,11 @@ TEST(PredicatesTest, InCircleMatchesOracle) {
     ++cases;
     zeros += want == 0;
   };
-  for (int i = 0; i < 4000; ++i) check({g.Point2(), g.Point2(), g.Point2(), g.Point2()});
+  for (int i = 0; i < N(4000); ++i) check({g.Point2(), g.Point2(), g.Point2(), g.Point2()});
   const std::vector<Vec2> circle = CirclePoints(25);  // 12 lattice points... and more
   ASSERT_GE(circle.size(), 12u);
   for (const Frame& f : kFrames) {
-    for (int i = 0; i < 500; ++i) {
+    for (int i = 0; i < N(500); ++i) {
       std::array<Vec2, 4> p;
       for (auto& q : p) q = Apply(f, circle[g.Int(0, int(circle.size()) - 1)] + Vec2{3, -7});
       check(p);
@@ -291,13 +300,13 @@ TEST(PredicatesTest, InCircleMatchesOracle) {
              Apply(f, g.IntPoint2(2))});
     }
   }
-  for (int i = 0; i < 2000; ++i) {
+  for (int i = 0; i < N(2000); ++i) {
     const Vec2 o{-1e6, 1e6};
     check({o + 1e-3 * g.IntPoint2(3), o + 1e-3 * g.IntPoint2(3), o + 1e-3 * g.IntPoint2(3),
            o + 1e-3 * g.IntPoint2(3)});
   }
-  EXPECT_GT(zeros, 1000);
-  EXPECT_GT(cases, 20000);
+  EXPECT_GT(zeros, N(1000));
+  EXPECT_GT(cases, N(20000));
 }
 
 TEST(PredicatesTest, InSphereMatchesOracle) {
@@ -310,13 +319,13 @@ TEST(PredicatesTest, InSphereMatchesOracle) {
     ++cases;
     zeros += want == 0;
   };
-  for (int i = 0; i < 4000; ++i) check({g.Point3(), g.Point3(), g.Point3(), g.Point3(), g.Point3()});
+  for (int i = 0; i < N(4000); ++i) check({g.Point3(), g.Point3(), g.Point3(), g.Point3(), g.Point3()});
   const std::vector<Vec3> sphere = SpherePoints(9);  // many lattice points on r = 9
   ASSERT_GE(sphere.size(), 30u);
   const Vec3 cube[8] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
                         {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
   for (const Frame& f : kFrames) {
-    for (int i = 0; i < 400; ++i) {
+    for (int i = 0; i < N(400); ++i) {
       std::array<Vec3, 5> p;
       for (auto& q : p) q = Apply(f, sphere[g.Int(0, int(sphere.size()) - 1)] + Vec3{2, -5, 1});
       check(p);
@@ -330,13 +339,13 @@ TEST(PredicatesTest, InSphereMatchesOracle) {
              Apply(f, g.IntPoint3(1)), Apply(f, g.IntPoint3(1))});
     }
   }
-  for (int i = 0; i < 2000; ++i) {
+  for (int i = 0; i < N(2000); ++i) {
     const Vec3 o{1e6, -1e6, 1e6};
     check({o + 1e-3 * g.IntPoint3(2), o + 1e-3 * g.IntPoint3(2), o + 1e-3 * g.IntPoint3(2),
            o + 1e-3 * g.IntPoint3(2), o + 1e-3 * g.IntPoint3(2)});
   }
-  EXPECT_GT(zeros, 1000);
-  EXPECT_GT(cases, 20000);
+  EXPECT_GT(zeros, N(1000));
+  EXPECT_GT(cases, N(20000));
 }
 
 TEST(PredicatesTest, ConventionsOnSimpleCases) {
@@ -392,9 +401,9 @@ TEST(PredicatesTest, ExtraPredicatesMatchOracle) {
     }
     cases += 7;
   };
-  for (int i = 0; i < 2000; ++i) check_all({g.Point3(), g.Point3(), g.Point3(), g.Point3()});
+  for (int i = 0; i < N(2000); ++i) check_all({g.Point3(), g.Point3(), g.Point3(), g.Point3()});
   for (const Frame& f : kFrames) {
-    for (int i = 0; i < 300; ++i) {
+    for (int i = 0; i < N(300); ++i) {
       std::array<Vec3, 4> p;
       // Cospherical with a sphere centred at the origin: a, b antipodal on the
       // lattice sphere make p on the diametral sphere; the circumball of a
@@ -411,8 +420,8 @@ TEST(PredicatesTest, ExtraPredicatesMatchOracle) {
       check_all(p);
     }
   }
-  EXPECT_GT(zeros, 500);
-  EXPECT_GT(cases, 20000);
+  EXPECT_GT(zeros, N(500));
+  EXPECT_GT(cases, N(20000));
 }
 
 // ------------------------------------------------------ SoS
@@ -482,7 +491,7 @@ int Parity(const std::array<int, N>& perm) {
 TEST(PredicatesSoSTest, Orient2dSoS) {
   Gen g(21);
   const Q eps(mpz_class(1), mpz_class(1) << 40);
-  for (int i = 0; i < 3000; ++i) {
+  for (int i = 0; i < N(3000); ++i) {
     // Small grid: many collinear (and some coincident) triples.
     std::array<Vec2, 3> p = {g.IntPoint2(2), g.IntPoint2(2), g.IntPoint2(2)};
     std::array<uint32_t, 3> ids = {uint32_t(g.Int(0, 1000)), 0, 0};
@@ -508,7 +517,7 @@ TEST(PredicatesSoSTest, Orient2dSoS) {
 TEST(PredicatesSoSTest, Orient3dSoS) {
   Gen g(22);
   const Q eps(mpz_class(1), mpz_class(1) << 24);
-  for (int i = 0; i < 1500; ++i) {
+  for (int i = 0; i < N(1500); ++i) {
     std::array<Vec3, 4> p = {g.IntPoint3(1), g.IntPoint3(1), g.IntPoint3(1), g.IntPoint3(1)};
     std::array<uint32_t, 4> ids;
     for (int k = 0; k < 4; ++k) ids[k] = k * 7 + g.Int(0, 6);
@@ -519,7 +528,7 @@ TEST(PredicatesSoSTest, Orient3dSoS) {
     if (exact != 0) {
       ASSERT_EQ(s, exact);
     }
-    if (i < 300) {
+    if (i < N(300)) {
       std::array<std::array<double, 3>, 4> pts;
       for (int k = 0; k < 4; ++k) pts[k] = {p[k].x, p[k].y, p[k].z};
       ASSERT_EQ(s, OracleOrientSoS<3>(pts, ids, eps)) << i;
@@ -538,7 +547,7 @@ TEST(PredicatesSoSTest, InCircleSoS) {
   const std::vector<Vec2> circle = CirclePoints(5);  // 12 points
   const Q eps(mpz_class(1), mpz_class(1) << 60);
   int decided_by_sos = 0;
-  for (int i = 0; i < 3000; ++i) {
+  for (int i = 0; i < N(3000); ++i) {
     std::array<Vec2, 4> p;
     if (i % 2) {
       std::vector<Vec2> pool = circle;
@@ -569,7 +578,7 @@ TEST(PredicatesSoSTest, InCircleSoS) {
                 Parity(perm) * s);
     }
   }
-  EXPECT_GT(decided_by_sos, 500);
+  EXPECT_GT(decided_by_sos, N(500));
 }
 
 TEST(PredicatesSoSTest, InSphereSoS) {
@@ -577,7 +586,7 @@ TEST(PredicatesSoSTest, InSphereSoS) {
   const std::vector<Vec3> sphere = SpherePoints(3);  // 30 points on r = 3
   const Q eps(mpz_class(1), mpz_class(1) << 60);
   int decided_by_sos = 0;
-  for (int i = 0; i < 1500; ++i) {
+  for (int i = 0; i < N(1500); ++i) {
     std::array<Vec3, 5> p;
     if (i % 2) {
       std::vector<Vec3> pool = sphere;
@@ -598,7 +607,7 @@ TEST(PredicatesSoSTest, InSphereSoS) {
     }
     decided_by_sos += exact == 0;
     ASSERT_EQ(s, OracleInSphereSoS(p, ids, eps));
-    if (i < 200) {
+    if (i < N(200)) {
       std::array<int, 5> perm = {0, 1, 2, 3, 4};
       while (std::next_permutation(perm.begin(), perm.end())) {
         ASSERT_EQ(InSphereSoS(p[perm[0]], p[perm[1]], p[perm[2]], p[perm[3]], p[perm[4]],
@@ -607,7 +616,7 @@ TEST(PredicatesSoSTest, InSphereSoS) {
       }
     }
   }
-  EXPECT_GT(decided_by_sos, 300);
+  EXPECT_GT(decided_by_sos, N(300));
 }
 
 // Brute-force Delaunay of the 8 cube corners (all cospherical) under SoS: the
