@@ -1,6 +1,6 @@
 // Exact orientation signs used by the PLC readers and validation (coplanar
-// merging, intersection tests, point-on-segment). One place to plug in
-// core/geometry/predicates.h: every sign decision of core/plc goes through here.
+// merging, intersection tests, point-on-segment): thin wrappers over
+// core/geometry/predicates.h; every sign decision of core/plc goes through here.
 #pragma once
 
 #include "core/geometry/vec3.h"

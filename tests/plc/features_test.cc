@@ -109,12 +109,11 @@ TEST(Features, ThreeFacetsAt120DegreesAroundAnEdge) {
   FeatureOptions fo;
   ValidationReport report;
   absl::StatusOr<FeatureComplex> fc = PreparePlc(plc, vo, fo, &report);
-  // Open (fins only): rejected by the closedness rule, so measure the angles
-  // on the complex built without that rule's verdict: validate the closed
-  // variant below, and check the angle here through a closed prism set.
+  // Three fins alone enclose nothing: rejected by the closedness rule.
   EXPECT_FALSE(fc.ok());
-  // Close it: add the three outer faces and end caps (triangles split by the
-  // spokes), making three 120° prisms around the shared edge.
+  ASSERT_NE(report.Find(ProblemKind::kOpenBoundary), nullptr);
+  // Close them into three 120° prisms around the shared edge (outer faces and
+  // end-cap triangles); the edge then lies on three facets.
   for (int k = 0; k < 3; ++k) {
     const int j = (k + 1) % 3;
     plc.facets.push_back(Quad(2 + 2 * k, 2 + 2 * j, 3 + 2 * j, 3 + 2 * k));
