@@ -101,12 +101,13 @@ class Expansion {
   Expansion& operator*=(const Expansion& f) { return *this = *this * f; }
 
  private:
-  // Components in a small buffer (no allocation up to kInline words), on the
+  // Components in a small buffer (no allocation up to kInline words: enough
+  // for in-sphere on inputs whose coordinate differences are exact), on the
   // heap beyond. (Own type: absl::InlinedVector trips GCC 12's
   // -Wmaybe-uninitialized under -O3 -Werror.)
   class Words {
    public:
-    static constexpr uint32_t kInline = 12;
+    static constexpr uint32_t kInline = 40;
     Words() = default;
     Words(const Words& o) { CopyFrom(o); }
     Words& operator=(const Words& o) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <initializer_list>
 
 #include <gmpxx.h>
@@ -35,6 +36,11 @@ template <>
 mpq_class Cv<mpq_class>(double x) {
   return mpq_class(x);
 }
+template <>
+double Cv<double>(double x) {
+  return x;
+}
+int SignOfT(double x) { return SignOf(x); }
 int SignOfT(const Expansion& e) { return e.Sign(); }
 int SignOfT(const mpq_class& q) { return sgn(q); }
 
@@ -66,11 +72,15 @@ struct ScalePlan {
   bool use_gmp = false;
 };
 
+// x ≠ 0 finite: the exponent of its lowest set bit (x = odd·2^result).
 int LowestSetBitExponent(double x) {
-  int e;
-  const double m = std::frexp(std::fabs(x), &e);  // |x| = m·2^e, m in [0.5, 1)
-  const uint64_t mant = static_cast<uint64_t>(std::ldexp(m, 53));
-  return e - 53 + __builtin_ctzll(mant);
+  uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+  uint64_t mant = bits & ((uint64_t{1} << 52) - 1);
+  if (biased == 0) return -1074 + __builtin_ctzll(mant);  // subnormal: mant·2^-1074
+  mant |= uint64_t{1} << 52;                               // normal: mant·2^(biased−1075)
+  return biased - 1075 + __builtin_ctzll(mant);
 }
 
 ScalePlan PlanScaling(const double* v, int n, int degree) {
@@ -98,6 +108,32 @@ int ExactSign(const double* coords, int n, int degree, Eval eval) {
   double scaled[32];
   for (int i = 0; i < n; ++i) scaled[i] = plan.k == 0 ? coords[i] : std::ldexp(coords[i], plan.k);
   return eval(static_cast<Expansion*>(nullptr), scaled);
+}
+
+// -------------------------------------------- small-integer exact fast path
+// Grids and other "nice" inputs make the filter fail on exactly degenerate
+// configurations all the time. When every coordinate difference the formula
+// uses is exact in doubles and equal to n·2^g for one g with |n| < 2^bits,
+// every product/sum of the degree-d formula is an integer multiple of 2^(d·g)
+// below 2^53 of them, so plain double evaluation is exact. `bits` per formula:
+// orient2d 26, orient3d 16, incircle 12, insphere 9 (2^(5·9+6.2) < 2^53: the
+// bound on |lift·3×3 minor| summed over four terms). Differences are taken
+// against point `ref` (as in the formulas).
+bool SmallDyadicDiffs(const double* c, int npts, int dim, int ref, int bits, int degree) {
+  int g = 1 << 20, top = -(1 << 20);
+  for (int i = 0; i < npts; ++i) {
+    if (i == ref) continue;
+    for (int j = 0; j < dim; ++j) {
+      double d, tail;
+      TwoDiff(c[i * dim + j], c[ref * dim + j], d, tail);
+      if (tail != 0 || !std::isfinite(d)) return false;
+      if (d == 0) continue;
+      g = std::min(g, LowestSetBitExponent(d));
+      top = std::max(top, std::ilogb(d));
+    }
+  }
+  if (top < g) return true;  // all differences zero
+  return top - g < bits && degree * g >= -1000 && degree * (top + 2) <= 1000;
 }
 
 // ------------------------------------------------------ exact core predicates
@@ -157,6 +193,7 @@ int InSpherePoly(const double* c) {
 
 int Orient2dExactImpl(Vec2 a, Vec2 b, Vec2 c) {
   const double v[6] = {a.x, a.y, b.x, b.y, c.x, c.y};
+  if (SmallDyadicDiffs(v, 3, 2, 0, 26, 2)) return Orient2dPoly<double>(v);
   return ExactSign(v, 6, 2, [](auto* tag, const double* q) {
     return Orient2dPoly<std::remove_pointer_t<decltype(tag)>>(q);
   });
@@ -164,6 +201,7 @@ int Orient2dExactImpl(Vec2 a, Vec2 b, Vec2 c) {
 
 int Orient3dExactImpl(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+  if (SmallDyadicDiffs(v, 4, 3, 0, 16, 3)) return Orient3dPoly<double>(v);
   return ExactSign(v, 12, 3, [](auto* tag, const double* q) {
     return Orient3dPoly<std::remove_pointer_t<decltype(tag)>>(q);
   });
@@ -171,6 +209,7 @@ int Orient3dExactImpl(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d
 
 int InCircleExactImpl(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
   const double v[8] = {a.x, a.y, b.x, b.y, c.x, c.y, d.x, d.y};
+  if (SmallDyadicDiffs(v, 4, 2, 3, 12, 4)) return InCirclePoly<double>(v);
   return ExactSign(v, 8, 4, [](auto* tag, const double* q) {
     return InCirclePoly<std::remove_pointer_t<decltype(tag)>>(q);
   });
@@ -179,6 +218,7 @@ int InCircleExactImpl(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
 int InSphereExactImpl(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e) {
   const double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z,
                         d.x, d.y, d.z, e.x, e.y, e.z};
+  if (SmallDyadicDiffs(v, 5, 3, 4, 9, 5)) return InSpherePoly<double>(v);
   return ExactSign(v, 15, 5, [](auto* tag, const double* q) {
     return InSpherePoly<std::remove_pointer_t<decltype(tag)>>(q);
   });
@@ -356,7 +396,7 @@ int InCircleSoSTail(Vec2 a, Vec2 b, Vec2 c, Vec2 d, uint32_t ia, uint32_t ib, ui
       for (int j = 0, k = 0; j < 4; ++j) {
         if (j != i) q[k++] = p[j];
       }
-      const int o = Orient2dExactImpl(q[0], q[1], q[2]);
+      const int o = Orient2dUncounted(q[0], q[1], q[2]);
       if (o == 0) continue;
       const int cofactor = ((i + 1) % 2 == 0) ? o : -o;
       return -cofactor;
@@ -379,7 +419,7 @@ int InSphereSoSTail(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, 
       for (int j = 0, k = 0; j < 5; ++j) {
         if (j != i) q[k++] = p[j];
       }
-      const int o = Orient3dExactImpl(q[0], q[1], q[2], q[3]);
+      const int o = Orient3dUncounted(q[0], q[1], q[2], q[3]);
       if (o == 0) continue;
       const int cofactor = ((i + 1 + 5) % 2 == 0) ? o : -o;
       return -cofactor;

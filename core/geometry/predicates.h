@@ -145,8 +145,10 @@ inline int Orient1d(double a, double b) {
   return (b > a) - (b < a);
 }
 
-inline int Orient2d(Vec2 a, Vec2 b, Vec2 c) {
-  internal::CountCall(Pred::kOrient2d);
+namespace internal {
+// The filtered predicates without the call counter (used inside other
+// predicates' exact/SoS stages so those are not counted twice).
+inline int Orient2dUncounted(Vec2 a, Vec2 b, Vec2 c) {
   const double bax = b.x - a.x, bay = b.y - a.y;
   const double cax = c.x - a.x, cay = c.y - a.y;
   const double det = bax * cay - bay * cax;
@@ -155,15 +157,21 @@ inline int Orient2d(Vec2 a, Vec2 b, Vec2 c) {
   const double lo = std::min(mx, my), hi = std::max(mx, my);
   if (lo == 0) return 0;  // a zero column: the determinant is exactly 0
   if (lo > 1e-146 && hi < 1e146) {
-    const double eps = internal::kOrient2dBound * mx * my;
+    const double eps = kOrient2dBound * mx * my;
     if (det > eps) return 1;
     if (det < -eps) return -1;
   }
   return internal::Orient2dExact(a, b, c);
 }
+}  // namespace internal
 
-inline int Orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  internal::CountCall(Pred::kOrient3d);
+inline int Orient2d(Vec2 a, Vec2 b, Vec2 c) {
+  internal::CountCall(Pred::kOrient2d);
+  return internal::Orient2dUncounted(a, b, c);
+}
+
+namespace internal {
+inline int Orient3dUncounted(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const double bax = b.x - a.x, bay = b.y - a.y, baz = b.z - a.z;
   const double cax = c.x - a.x, cay = c.y - a.y, caz = c.z - a.z;
   const double dax = d.x - a.x, day = d.y - a.y, daz = d.z - a.z;
@@ -176,11 +184,17 @@ inline int Orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) 
   const double hi = std::max(std::max(mx, my), mz);
   if (lo == 0) return 0;
   if (lo > 1e-97 && hi < 1e97) {
-    const double eps = internal::kOrient3dBound * mx * my * mz;
+    const double eps = kOrient3dBound * mx * my * mz;
     if (det > eps) return 1;
     if (det < -eps) return -1;
   }
   return internal::Orient3dExact(a, b, c, d);
+}
+}  // namespace internal
+
+inline int Orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  internal::CountCall(Pred::kOrient3d);
+  return internal::Orient3dUncounted(a, b, c, d);
 }
 
 inline int InCircle(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {

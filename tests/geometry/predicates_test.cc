@@ -348,6 +348,51 @@ TEST(PredicatesTest, InSphereMatchesOracle) {
   EXPECT_GT(cases, N(20000));
 }
 
+// Around the bit limits of the small-integer exact path: integer points whose
+// differences straddle 2^9 (insphere), 2^12 (incircle), 2^16 (orient3d),
+// exactly degenerate and nudged by one unit.
+TEST(PredicatesTest, SmallIntegerPathBoundaries) {
+  Gen g(16);
+  // Lattice points on spheres/circles of radius ~ 200..300.
+  std::vector<Vec3> sphere;
+  for (int r : {221, 255, 289}) {
+    for (int x = -r; x <= r; x += 3) {
+      for (int y = -r; y <= r; y += 5) {
+        const long z2 = long(r) * r - long(x) * x - long(y) * y;
+        if (z2 < 0) continue;
+        const long z = std::lround(std::sqrt(double(z2)));
+        if (z * z == z2 && sphere.size() < 400) sphere.push_back({double(x), double(y), double(z)});
+      }
+    }
+  }
+  ASSERT_GE(sphere.size(), 20u);
+  for (int i = 0; i < N(3000); ++i) {
+    std::array<Vec3, 5> p;
+    for (auto& q : p) q = sphere[g.Int(0, int(sphere.size()) - 1)];
+    if (i % 2) {
+      double* c = const_cast<double*>(p[g.Int(0, 4)].data()) + g.Int(0, 2);
+      *c += g.Int(0, 1) ? 1 : -1;
+    }
+    ASSERT_EQ(InSphere(p[0], p[1], p[2], p[3], p[4]), OracleInSphere(p[0], p[1], p[2], p[3], p[4]))
+        << Show(p);
+  }
+  for (int i = 0; i < N(3000); ++i) {
+    const int s = 1 << g.Int(8, 14);
+    const Vec2 a{double(g.Int(-s, s)), double(g.Int(-s, s))}, d{double(g.Int(-s, s)), double(g.Int(-s, s))};
+    std::array<Vec2, 4> p = {a, Vec2{-a.y, a.x}, Vec2{-a.x, -a.y}, Vec2{a.y, -a.x}};  // cocircular
+    if (i % 3 == 1) p[3] = d;
+    if (i % 3 == 2) p[g.Int(0, 3)].x += 1;
+    ASSERT_EQ(InCircle(p[0], p[1], p[2], p[3]), OracleInCircle(p[0], p[1], p[2], p[3])) << Show(p);
+  }
+  for (int i = 0; i < N(3000); ++i) {
+    const int s = 1 << g.Int(12, 18);
+    const Vec3 o = g.IntPoint3(s), u = g.IntPoint3(s / 64), v = g.IntPoint3(s / 64);
+    std::array<Vec3, 4> p = {o, o + u, o + v, o + 3.0 * u - 2.0 * v};  // coplanar
+    if (i % 2) p[g.Int(0, 3)].z += 1;
+    ASSERT_EQ(Orient3d(p[0], p[1], p[2], p[3]), OracleOrient3d(p[0], p[1], p[2], p[3])) << Show(p);
+  }
+}
+
 TEST(PredicatesTest, ConventionsOnSimpleCases) {
   EXPECT_EQ(Orient2d({0, 0}, {1, 0}, {0, 1}), 1);
   EXPECT_EQ(Orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}), 1);
