@@ -370,13 +370,17 @@ class Preparer {
       fr.u = far > 0 ? dir / std::sqrt(far) : Vec3(1, 0, 0);
       fr.v = geom::Cross(fr.normal, fr.u);
       w.drop = DropAxis(fr.normal);
-      // Planarity: distance from the plane through origin with the Newell normal.
+      // Planarity: distance from the best-fit plane, i.e. the Newell normal
+      // through the centroid of the facet's points (relative to the origin).
       Box3 box;
+      Vec3 centroid;
+      for (PointId p : all) centroid += P_[p] - fr.origin;
+      centroid = fr.origin + centroid / static_cast<double>(all.size());
       double dmax = 0;
       PointId worst = all[0];
       for (PointId p : all) {
         box.Add(P_[p]);
-        const double d = std::fabs(geom::Dot(P_[p] - fr.origin, fr.normal));
+        const double d = std::fabs(geom::Dot(P_[p] - centroid, fr.normal));
         if (d > dmax) {
           dmax = d;
           worst = p;
