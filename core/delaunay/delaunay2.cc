@@ -224,11 +224,8 @@ Delaunay2::InsertResult Delaunay2::Insert(Vec2 p, uint32_t global_id, TriId hint
   }
 
   // Read everything we need from the cavity before freeing it.
-  struct BoundaryEdge {
-    uint32_t a, b, outer;
-  };
-  std::vector<BoundaryEdge> edges;
-  edges.reserve(boundary_.size());
+  std::vector<BoundaryEdge>& edges = edges_;
+  edges.clear();
   for (uint32_t be : boundary_) {
     const uint32_t t = be / 3;
     const int e = static_cast<int>(be % 3);

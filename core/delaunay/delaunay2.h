@@ -197,6 +197,10 @@ class Delaunay2 {
   std::vector<VertexId> cavity_vertices_;
   std::vector<uint32_t> boundary_;  // 3t+e of cavity-boundary edges (t inside)
   std::vector<uint32_t> stack_;
+  struct BoundaryEdge {
+    uint32_t a, b, outer;  // edge a→b of the cavity boundary, outer neighbour 3t+e
+  };
+  std::vector<BoundaryEdge> edges_;
   Stats stats_;
 };
 
