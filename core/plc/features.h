@@ -73,6 +73,9 @@ struct FeatureFacet {
   std::vector<std::vector<PointId>> loops;
   std::vector<bool> loop_is_hole;
   std::vector<SegmentId> segments;     // every segment lying in the facet, sorted
+  // The subset with the facet on both sides: in-facet segments (2-vertex
+  // polygons) and edges of in-facet polygons; the others bound the facet.
+  std::vector<SegmentId> interior_segments;
   std::vector<PointId> interior_points;  // points in the facet on none of its segments
   std::vector<Vec3> holes;             // facet hole seeds (input)
   // A triangulation of the facet region (loops minus holes), point-id triples,

@@ -586,6 +586,7 @@ class Preparer {
           for (const Owner& o : piece_owners_[sid]) {
             if (o.facet == f && (o.loop < 0 || w.two_sided[o.loop])) {
               cons.push_back({fc_.segments[sid].a, fc_.segments[sid].b});
+              ff.interior_segments.push_back(sid);
               break;
             }
           }

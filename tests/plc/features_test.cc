@@ -1,5 +1,6 @@
 // Feature complex: points/segments/facets, splitting, creases (thesis
 // Definitions 4-5) on hand-built PLCs and corpus files, and the spread Δ.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -159,6 +160,11 @@ TEST(Features, SegmentsSplitAtPointsOnThemAndFreeSegments) {
   const SegmentId s = fan.FindSegment(4, 8);
   ASSERT_NE(s, kNoId);
   EXPECT_THAT(fan.segments[s].facets, ElementsAre(1));
+  // 5 fan segments + the 3 edges of the in-facet triangle have the top facet
+  // on both sides.
+  EXPECT_EQ(fan.facets[1].interior_segments.size(), 8u);
+  EXPECT_TRUE(std::binary_search(fan.facets[1].interior_segments.begin(),
+                                 fan.facets[1].interior_segments.end(), s));
   // The two free segments meet at 1 degree at point 17 (0-based 16).
   EXPECT_TRUE(fan.points[16].crease);
   ASSERT_EQ(fan.pieces_of_free_segment.size(), 2u);
