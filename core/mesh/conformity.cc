@@ -599,8 +599,9 @@ class Checker {
   }
 
   // Enclosed volume by the divergence theorem, when the valid facets form
-  // closed, consistently orientable surfaces whose bounding boxes are
-  // disjoint, and there are no volume holes (docs/conformity.md).
+  // closed, consistently orientable 2-manifold surfaces (no internal facets);
+  // nested surfaces and volume holes are resolved by winding numbers
+  // (docs/conformity.md).
   void CheckVolume() {
     if (opt_.keep_bounding_box) {
       if (!mesh_box_.Empty()) {
@@ -621,7 +622,7 @@ class Checker {
   }
 
   void ComputeEnclosedVolume() {
-    if (!plc_->holes.empty() || facets_.empty()) return;
+    if (facets_.empty()) return;
     // Directed boundary edges: (facet, loop direction sign, u, v).
     struct Edge {
       std::array<uint32_t, 2> key;
@@ -675,20 +676,22 @@ class Checker {
     Box3 plc_box;
     for (const Vec3& p : plc_->vertices) plc_box.Add(p);
     const Vec3 o = plc_box.Center();
-    std::vector<Box3> comp_boxes;
-    double total = 0;
+    struct Shell {
+      std::vector<uint32_t> facets;
+      double volume = 0;  // |signed volume|
+    };
+    std::vector<Shell> shells;
     for (size_t s = 0; s < facets_.size(); ++s) {
       if (orient[s] != 0 || facets_[s].area == 0) continue;
       orient[s] = 1;
       std::vector<uint32_t> stack = {static_cast<uint32_t>(s)};
+      Shell shell;
       double vol = 0;
-      Box3 box;
       while (!stack.empty()) {
         const uint32_t f = stack.back();
         stack.pop_back();
+        shell.facets.push_back(f);
         const FacetGeom& fg = facets_[f];
-        box.Add(fg.box.lo);
-        box.Add(fg.box.hi);
         const Vec3 n = normal[f] / Norm(normal[f]);
         vol += orient[f] * fg.area * Dot(n, fg.plane.a - o) / 3.0;
         for (auto [g, rel] : adj[f]) {
@@ -701,13 +704,85 @@ class Checker {
           }
         }
       }
-      for (const Box3& b : comp_boxes) {
-        const bool disjoint = b.hi.x < box.lo.x || box.hi.x < b.lo.x || b.hi.y < box.lo.y ||
-                              box.hi.y < b.lo.y || b.hi.z < box.lo.z || box.hi.z < b.lo.z;
-        if (!disjoint) return;  // possibly nested shells: unknown
+      shell.volume = std::fabs(vol);
+      shells.push_back(std::move(shell));
+    }
+    // Nesting by generalized winding numbers (Jacobson et al. 2013: the sum
+    // of signed solid angles / 4π is an integer off a closed surface, so
+    // rounding decides robustly). inside[c][d]: shell c lies inside shell d.
+    constexpr size_t kMaxShells = 256;
+    if (shells.size() > kMaxShells) return;
+    const size_t ns = shells.size();
+    auto winding = [&](const Shell& sh, const Vec3& p) {
+      double total = 0;
+      for (uint32_t f : sh.facets) {
+        for (const Loop& l : facets_[f].loops) {
+          if (l.outer == l.hole) continue;  // subdivision, or removed outer loop
+          const int sign = (Dot(VectorArea(l.pts), normal[f]) > 0 ? 1 : -1) *
+                           (l.hole ? -1 : 1) * orient[f];
+          const Vec3 a = l.pts[0] - p;
+          for (size_t i = 1; i + 1 < l.pts.size(); ++i) {
+            const Vec3 b = l.pts[i] - p, c = l.pts[i + 1] - p;
+            // Van Oosterom & Strackee (1983): tan(Ω/2) = det / denominator.
+            const double la = Norm(a), lb = Norm(b), lc = Norm(c);
+            const double num = Dot(a, Cross(b, c));
+            const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
+            total += sign * 2 * std::atan2(num, den);
+          }
+        }
       }
-      comp_boxes.push_back(box);
-      total += std::fabs(vol);
+      return total / (4 * 3.14159265358979323846);
+    };
+    // Rounded |winding number| of p w.r.t. shell d, or -1 when p is (nearly)
+    // on the surface.
+    auto inside_of = [&](size_t d, const Vec3& p) {
+      const double w = winding(shells[d], p);
+      const double r = std::round(w);
+      return std::fabs(w - r) < 0.25 ? static_cast<int>(std::fabs(r)) : -1;
+    };
+    std::vector<std::vector<bool>> inside(ns, std::vector<bool>(ns, false));
+    for (size_t c = 0; c < ns; ++c) {
+      for (size_t d = 0; d < ns; ++d) {
+        if (c == d) continue;
+        // Try the vertices of c until one is clearly off d's surface.
+        int in = -1;
+        for (uint32_t f : shells[c].facets) {
+          for (const Loop& l : facets_[f].loops) {
+            for (const Vec3& p : l.pts) {
+              in = inside_of(d, p);
+              if (in >= 0) break;
+            }
+            if (in >= 0) break;
+          }
+          if (in >= 0) break;
+        }
+        if (in < 0 || in > 1) return;  // touching or self-overlapping shells: unknown
+        inside[c][d] = in == 1;
+      }
+    }
+    std::vector<int> depth(ns, 0);
+    for (size_t c = 0; c < ns; ++c) {
+      for (size_t d = 0; d < ns; ++d) depth[c] += inside[c][d] ? 1 : 0;
+    }
+    double total = 0;
+    for (size_t c = 0; c < ns; ++c) total += depth[c] == 0 ? shells[c].volume : 0;
+    // A volume hole removes the cell that contains its seed: the innermost
+    // shell around the seed minus the shells directly inside that one.
+    std::vector<bool> removed(ns, false);
+    for (const Vec3& h : plc_->holes) {
+      size_t cell = ns;
+      for (size_t d = 0; d < ns; ++d) {
+        const int in = inside_of(d, h);
+        if (in < 0) return;  // seed on a facet: unknown
+        if (in == 1 && (cell == ns || depth[d] > depth[cell])) cell = d;
+      }
+      if (cell == ns || removed[cell]) continue;  // in the exterior, or already removed
+      removed[cell] = true;
+      double hole = shells[cell].volume;
+      for (size_t d = 0; d < ns; ++d) {
+        if (inside[d][cell] && depth[d] == depth[cell] + 1) hole -= shells[d].volume;
+      }
+      total -= hole;
     }
     rep_->enclosed_volume = total;
     rep_->enclosed_volume_known = true;

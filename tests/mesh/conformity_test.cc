@@ -336,6 +336,61 @@ TEST(Conformity, CanonicalIndexRequirement) {
   EXPECT_TRUE(CheckConformity(p, m, by_coordinates).ok());
 }
 
+// The unit box with a box [0.25, 0.75]^3 inside (facet markers 11..16),
+// meshed by a Kuhn grid with n = 4 (conforms to both).
+struct Nested {
+  plc::Plc plc;
+  TetMesh mesh;
+};
+Nested BoxInBox(bool hole) {
+  Nested c;
+  c.plc = BoxPlc(kLo, kHi);
+  const plc::Plc inner = BoxPlc(Vec3(0.25, 0.25, 0.25), Vec3(0.75, 0.75, 0.75));
+  for (const Vec3& v : inner.vertices) c.plc.vertices.push_back(v);
+  for (plc::Facet f : inner.facets) {
+    for (auto& poly : f.polygons) {
+      for (auto& v : poly.vertices) v += 8;
+    }
+    f.marker += 10;
+    c.plc.facets.push_back(f);
+  }
+  c.mesh = KuhnBoxMesh(c.plc, 4);
+  if (hole) {
+    c.plc.holes.push_back(Vec3(0.5, 0.5, 0.5));
+    TetMesh& m = c.mesh;
+    std::vector<std::array<uint32_t, 4>> kept;
+    for (const auto& t : m.tets) {
+      const Vec3 g = (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]] + m.positions[t[3]]) / 4.0;
+      const bool in = g.x > 0.25 && g.x < 0.75 && g.y > 0.25 && g.y < 0.75 && g.z > 0.25 && g.z < 0.75;
+      if (!in) kept.push_back(t);
+    }
+    m.tets = kept;
+    m.tet_region.assign(kept.size(), 0);
+  }
+  testing::AssignAxisAlignedTriangles(c.plc, &c.mesh);
+  return c;
+}
+
+TEST(Conformity, NestedShellsAndVolumeHoles) {
+  const Nested solid = BoxInBox(/*hole=*/false);
+  const ConformityReport r = CheckConformity(solid.plc, solid.mesh);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  ASSERT_TRUE(r.enclosed_volume_known);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);  // the inner box is a region, not a hole
+  const Nested holed = BoxInBox(/*hole=*/true);
+  const ConformityReport rh = CheckConformity(holed.plc, holed.mesh);
+  EXPECT_TRUE(rh.ok()) << rh.Summary();
+  ASSERT_TRUE(rh.enclosed_volume_known);
+  EXPECT_NEAR(rh.enclosed_volume, 0.875, 1e-12);
+  // The same hollow mesh without the hole seed: a whole region is missing,
+  // and only the volume shows it (its faces all lie on facets).
+  plc::Plc no_seed = holed.plc;
+  no_seed.holes.clear();
+  const ConformityReport rm = CheckConformity(no_seed, holed.mesh);
+  EXPECT_EQ(rm.Count(ViolationKind::kVolumeMismatch), 1u) << rm.Summary();
+  EXPECT_EQ(rm.violations.size(), 1u) << rm.Summary();
+}
+
 TEST(Conformity, ScalesToHundredsOfThousandsOfTets) {
   const plc::Plc p = BoxPlc(kLo, kHi, /*split=*/true);
   const TetMesh m = KuhnBoxMesh(p, 24);  // 82,944 tets

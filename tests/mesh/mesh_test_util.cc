@@ -128,6 +128,49 @@ void AssignBoxTriangles(const plc::Plc& box_plc, TetMesh* mesh) {
   }
 }
 
+void AssignAxisAlignedTriangles(const plc::Plc& plc, TetMesh* mesh) {
+  TetMesh& m = *mesh;
+  std::map<std::array<uint32_t, 3>, int32_t> tris;
+  for (const auto& t : m.tets) {
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<uint32_t, 3> f;
+      int w = 0;
+      for (int v = 0; v < 4; ++v) {
+        if (v != skip) f[w++] = t[v];
+      }
+      std::sort(f.begin(), f.end());
+      if (tris.count(f)) continue;
+      const Vec3 c = (m.positions[f[0]] + m.positions[f[1]] + m.positions[f[2]]) / 3.0;
+      for (const auto& facet : plc.facets) {
+        geom::Box3 box;
+        for (const auto& poly : facet.polygons) {
+          for (uint32_t v : poly.vertices) box.Add(plc.vertices[v]);
+        }
+        int axis = -1;
+        for (int a = 0; a < 3; ++a) {
+          if (box.lo[a] == box.hi[a]) axis = a;
+        }
+        if (axis < 0) continue;
+        bool on = true;
+        for (uint32_t v : f) on = on && m.positions[v][axis] == box.lo[axis];
+        for (int a = 0; a < 3; ++a) {
+          if (a != axis) on = on && c[a] >= box.lo[a] && c[a] <= box.hi[a];
+        }
+        if (on) {
+          tris.emplace(f, facet.marker);
+          break;
+        }
+      }
+    }
+  }
+  m.triangles.clear();
+  m.triangle_marker.clear();
+  for (const auto& [key, marker] : tris) {
+    m.triangles.push_back(key);
+    m.triangle_marker.push_back(marker);
+  }
+}
+
 double TotalVolume(const TetMesh& mesh) {
   double v = 0;
   for (const auto& t : mesh.tets) {

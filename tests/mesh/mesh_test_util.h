@@ -26,6 +26,11 @@ TetMesh KuhnBoxMesh(const plc::Plc& box_plc, int n);
 // as in BoxPlc) and, when the PLC is split, on the internal facet (marker 7).
 void AssignBoxTriangles(const plc::Plc& box_plc, TetMesh* mesh);
 
+// Replaces mesh->triangles by the tet faces lying on an axis-aligned
+// rectangular facet of `plc` (the facet's bounding box is flat along one axis),
+// each with that facet's marker (first facet wins).
+void AssignAxisAlignedTriangles(const plc::Plc& plc, TetMesh* mesh);
+
 // Sum of the floating-point tet volumes.
 double TotalVolume(const TetMesh& mesh);
 

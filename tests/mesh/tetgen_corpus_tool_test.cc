@@ -68,6 +68,11 @@ TEST_P(TetgenCorpus, CheckerAcceptsTetgenMesh) {
   // example.poly: facet #20 separates a volume hole from the exterior; every
   // other facet of these inputs bounds the domain.
   EXPECT_EQ(r.num_facets_outside, c.file == "b_internal/example.poly" ? 1u : 0u);
+  // Internal facets make the facet complex non-manifold: volume unknown
+  // there (docs/conformity.md); every other input's volume is checked.
+  const bool internal_facets =
+      c.file == "b_internal/box_internal_facet.poly" || c.file == "b_internal/example.poly";
+  EXPECT_EQ(r.enclosed_volume_known, !internal_facets);
   if (r.enclosed_volume_known) {
     EXPECT_NEAR(r.mesh_volume, r.enclosed_volume, 1e-9 * r.enclosed_volume);
   }
