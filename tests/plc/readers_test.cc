@@ -3,6 +3,8 @@
 // malformed inputs give INVALID_ARGUMENT with file:line.
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <fstream>
 #include <set>
 #include <string>
 #include <vector>
@@ -323,6 +325,32 @@ TEST(Readers, FormatFromPath) {
   EXPECT_EQ(FormatFromPath("x.ply").status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(FormatFromPath("dir.d/noext").status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(FormatName(InputFormat::kSmesh), "smesh");
+}
+
+}  // namespace
+}  // namespace svrc::plc
+
+namespace svrc::plc {
+namespace {
+
+TEST(Readers, PolyWithSeparateNodeFile) {
+  const std::string dir = svrc::testing::MakeTempDir("plc_node");
+  {
+    std::ofstream(dir + "/t.node") << "4 3 0 1\n1 0 0 0 5\n2 1 0 0 5\n3 0 1 0 5\n4 0 0 1 6\n";
+    std::ofstream(dir + "/t.poly") << "0 3 0 0\n4 0\n1\n3 1 2 3\n1\n3 1 2 4\n1\n3 1 3 4\n1\n3 2 3 4\n";
+  }
+  absl::StatusOr<Plc> plc = ReadPlcFile(dir + "/t.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  EXPECT_EQ(plc->vertices.size(), 4u);
+  EXPECT_EQ(plc->facets.size(), 4u);
+  EXPECT_EQ(plc->vertex_markers[3], 6);
+  EXPECT_EQ(plc->facets[3].polygons[0].vertices, (std::vector<uint32_t>{1, 2, 3}));
+  // Without the .node file: a clear error.
+  absl::StatusOr<Plc> bytes_only = ReadPlcBytes("0 3 0 0\n1 0\n1\n3 1 2 3\n", InputFormat::kPoly, "m.poly");
+  EXPECT_EQ(bytes_only.status().code(), absl::StatusCode::kInvalidArgument);
+  const absl::StatusOr<Plc> node = ReadPlcFile(dir + "/t.node");
+  ASSERT_TRUE(node.ok()) << node.status();
+  EXPECT_TRUE(node->IsPointSet());
 }
 
 }  // namespace
