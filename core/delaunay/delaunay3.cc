@@ -70,19 +70,27 @@ void Delaunay3::Reserve(size_t num_vertices) {
 // Tet slots.
 
 inline uint32_t Delaunay3::NewTet() {
-  uint32_t t;
-  if (free_head_ != kFreeSlot) {
-    t = free_head_;
-    free_head_ = tet_n_[4 * t];
-  } else {
-    t = static_cast<uint32_t>(tet_gen_.size());
-    tet_v_.resize(tet_v_.size() + 4);
-    tet_n_.resize(tet_n_.size() + 4);
-    tet_gen_.push_back(0);
-    tet_mark_.push_back(0);
-  }
+  if (free_head_ == kFreeSlot) GrowTets();
+  const uint32_t t = free_head_;
+  free_head_ = tet_n_[4 * t];
   ++num_live_tets_;
   return t;
+}
+
+// Appends a batch of free slots (lowest id first on the free list), so the
+// arrays grow in bulk rather than per tet.
+void Delaunay3::GrowTets() {
+  const uint32_t old_cap = TetCapacity();
+  const uint32_t add = std::max<uint32_t>(64, old_cap / 4);
+  const size_t cap = size_t{old_cap} + add;
+  tet_v_.resize(4 * cap, kFreeSlot);
+  tet_n_.resize(4 * cap, 0);
+  tet_gen_.resize(cap, 0);
+  tet_mark_.resize(cap, 0);
+  for (uint32_t t = static_cast<uint32_t>(cap); t-- > old_cap;) {
+    tet_n_[4 * t] = free_head_;
+    free_head_ = t;
+  }
 }
 
 inline void Delaunay3::FreeTet(uint32_t t) {
@@ -111,7 +119,7 @@ uint32_t Delaunay3::FreshStamps(uint32_t n) const {
 
 // Conflict of tet t with p. Sets *sos_used when the decision needed the
 // symbolic perturbation (an exactly cospherical / coplanar configuration).
-inline bool Delaunay3::ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid,
+[[gnu::always_inline]] inline bool Delaunay3::ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid,
                                    uint32_t* sos_used) const {
   const uint32_t* v = &tet_v_[4 * t];
   if (v[3] != kInf) {

@@ -200,6 +200,7 @@ class Delaunay3 {
   static constexpr uint32_t kInf = 0xFFFFFFFEu;
 
   uint32_t NewTet();
+  void GrowTets();
   void FreeTet(uint32_t t);
   uint32_t FreshStamps(uint32_t n) const;
   bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
