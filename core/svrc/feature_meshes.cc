@@ -196,4 +196,68 @@ CellSize OmegaMesh::Size(VertexId v) const {
   return out;
 }
 
+SegmentMesh::SegmentMesh(PointId a, PointId b, const Vec3& pa, const Vec3& pb) : pa_(pa), pb_(pb) {
+  const uint32_t va = AddVertex(0.0, a);
+  const uint32_t vb = AddVertex(1.0, b);
+  next_[va] = vb;
+  prev_[vb] = va;
+}
+
+uint32_t SegmentMesh::AddVertex(double t, PointId p) {
+  const uint32_t v = NumVertices();
+  t_.push_back(t);
+  point_.push_back(p);
+  next_.push_back(kNil);
+  prev_.push_back(kNil);
+  cell_gen_.push_back(1);
+  skinny_event_.emplace_back();
+  piece_ball_.push_back(kNoneBall);
+  vertex_ball_.push_back(kNoneBall);
+  return v;
+}
+
+Vec3 SegmentMesh::PointAt(double t) const {
+  if (t == 0.0) return pa_;
+  if (t == 1.0) return pb_;
+  return pa_ + t * (pb_ - pa_);
+}
+
+double SegmentMesh::PieceLength(uint32_t v) const {
+  return (t_[next_[v]] - t_[v]) * geom::Dist(pa_, pb_);
+}
+
+uint32_t SegmentMesh::Split(uint32_t v, double t, PointId p) {
+  const uint32_t w = next_[v];
+  const uint32_t m = AddVertex(t, p);
+  next_[v] = m;
+  prev_[m] = v;
+  next_[m] = w;
+  prev_[w] = m;
+  return m;
+}
+
+SegmentMesh::Size1 SegmentMesh::Size(uint32_t v) const {
+  Size1 s;
+  double lo = HUGE_VAL, hi = -1;
+  if (prev_[v] != kNil) {
+    const double g = PieceLength(prev_[v]);
+    lo = std::min(lo, g);
+    if (g > hi) {
+      hi = g;
+      s.piece = prev_[v];
+    }
+  }
+  if (next_[v] != kNil) {
+    const double g = PieceLength(v);
+    lo = std::min(lo, g);
+    if (g > hi) {
+      hi = g;
+      s.piece = v;
+    }
+  }
+  s.outradius = 0.5 * hi;
+  s.inradius = 0.5 * lo;
+  return s;
+}
+
 }  // namespace svrc::refine

@@ -99,4 +99,54 @@ class OmegaMesh {
   mutable std::vector<geom::Vec3> poly_, poly2_;
 };
 
+// The 1D mesh M_s of a segment s = ab (thesis §3.1: Ω_s = s, seeded with its
+// endpoints): vertices ordered by their parameter t ∈ [0, 1] along s (the only
+// coordinate M_s reads; docs/svrc-design.md §2), kept as a doubly-linked list
+// in arrays. Local vertex ids are dense in creation order (a = 0, b = 1).
+class SegmentMesh {
+ public:
+  static constexpr uint32_t kNil = 0xFFFFFFFFu;
+
+  SegmentMesh(PointId a, PointId b, const geom::Vec3& pa, const geom::Vec3& pb);
+
+  uint32_t NumVertices() const { return static_cast<uint32_t>(t_.size()); }
+  double T(uint32_t v) const { return t_[v]; }
+  PointId PointOf(uint32_t v) const { return point_[v]; }
+  uint32_t Next(uint32_t v) const { return next_[v]; }  // kNil at b
+  uint32_t Prev(uint32_t v) const { return prev_[v]; }  // kNil at a
+  // The point at parameter t: a + t(b − a), exactly a at 0 and b at 1.
+  geom::Vec3 PointAt(double t) const;
+  // 3D length of the piece between consecutive vertices v and Next(v).
+  double PieceLength(uint32_t v) const;
+
+  // Splits the piece (v, Next(v)) at parameter t (strictly between) with
+  // global point p; returns the new local vertex.
+  uint32_t Split(uint32_t v, double t, PointId p);
+
+  // 1D Voronoi cell of v clipped to Ω_s = s: R_v = half the longer adjacent
+  // piece, r_v = half the shorter (Lemma 3); the farthest corner is the
+  // midpoint of the longer piece (an endpoint's cell has one piece).
+  struct Size1 {
+    double outradius = 0, inradius = 0;
+    uint32_t piece = kNil;  // the piece (by its first vertex) whose midpoint is the corner
+  };
+  Size1 Size(uint32_t v) const;
+
+  void BumpCell(uint32_t v) { ++cell_gen_[v]; }
+  uint32_t CellGeneration(uint32_t v) const { return cell_gen_[v]; }
+  EventHandle& SkinnyEvent(uint32_t v) { return skinny_event_[v]; }
+  // The ConfBall of the piece starting at v (kNoneBall at b), and v's 0-ball.
+  BallId& PieceBall(uint32_t v) { return piece_ball_[v]; }
+  BallId& VertexBall(uint32_t v) { return vertex_ball_[v]; }
+
+ private:
+  uint32_t AddVertex(double t, PointId p);
+  geom::Vec3 pa_, pb_;
+  std::vector<double> t_;
+  std::vector<PointId> point_;
+  std::vector<uint32_t> next_, prev_, cell_gen_;
+  std::vector<EventHandle> skinny_event_;
+  std::vector<BallId> piece_ball_, vertex_ball_;
+};
+
 }  // namespace svrc::refine

@@ -1,9 +1,10 @@
 // The SVRC refiner (thesis §3.3): main loop (Figure 3.2), Initialize (3.3),
 // Destroy (3.4: warp, else yield, else insert the centre), ForceInsert (3.5),
 // UpdateLocation (3.6) and PropagateLocation (3.9), with the corrections of the
-// implementer's guide §3. This is stage (a) of the guide's build plan: M_Ω and
-// the input points as 0-dimensional features (point-set SVR); segments and
-// facets come with stages (b)–(c). Decisions: docs/svrc-design.md.
+// implementer's guide §3. Stages (a) and (b) of the guide's build plan: M_Ω,
+// input points (0-balls) and free segments (1D meshes, piece ConfBalls,
+// encroachment, partial encroachment, yield); facets and collars come with
+// stages (c)–(f). Decisions: docs/svrc-design.md.
 #pragma once
 
 #include <array>
@@ -42,6 +43,7 @@ struct RefineStats {
   uint64_t vertices = 0;           // in M_Ω at the end (corners included)
   uint64_t input_vertices = 0;     // (dimension 0)
   uint64_t steiner_vertices = 0;   // created in M_Ω (dimension 3), corners excluded
+  uint64_t segment_vertices = 0;   // created in segment meshes (dimension 1)
   uint64_t insertions = 0;
   uint64_t warps = 0;              // Destroy line 6
   uint64_t yields = 0;             // Destroy line 13
@@ -80,6 +82,9 @@ struct PointSetRefinement {
   std::vector<uint32_t> input_vertex;
   // Ω in input coordinates.
   geom::Box3 omega;
+  // Per input segment: its vertices from a to b as position indices (a chain
+  // of edges of the tets; stage (b)).
+  std::vector<std::vector<uint32_t>> segment_chains;
   RefineStats stats;
 };
 
@@ -90,5 +95,20 @@ struct PointSetRefinement {
 // check failed with validate_every > 0; message names it).
 absl::StatusOr<PointSetRefinement> RefinePointSet(std::span<const geom::Vec3> points,
                                                   const RefineOptions& options);
+
+// A free segment between two input points (indices into `points`).
+struct SegmentInput {
+  uint32_t a = 0, b = 0;
+};
+
+// Stage (b): points and free segments. The segments must be a valid complex
+// with the points ("plc" validates PLCs): distinct endpoints, no point of the
+// input strictly inside a segment, segments meeting only at endpoints.
+// INVALID_ARGUMENT for endpoint ids out of range or equal. At the end every
+// segment is a chain of M_Ω edges (`segment_chains`) and every cell of M_Ω and
+// of each segment mesh has R_v/r_v ≤ τ.
+absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const geom::Vec3> points,
+                                                           std::span<const SegmentInput> segments,
+                                                           const RefineOptions& options);
 
 }  // namespace svrc::refine
