@@ -158,10 +158,9 @@ absl::StatusOr<PointSetResult> TetrahedralizePointSet(std::span<const geom::Vec3
   result.seconds_insert = SecondsSince(t0);
 
   t0 = std::chrono::steady_clock::now();
-  // Canonical rotation, then a counting sort by the first (smallest) id and
-  // a small sort per bucket: linear but for the buckets' sizes (~6.7 tets
-  // per vertex on average).
-  std::vector<uint32_t> bucket_start(n + 1, 0);
+  // Canonical rotation, then an LSD radix sort on the first (smallest) id
+  // with 11-bit digits (sequential reads, 2048 write streams per pass), then
+  // a small sort of each run of equal first ids (~6.7 tets per vertex).
   std::vector<std::array<uint32_t, 4>> rotated;
   rotated.reserve(dt.NumFiniteTets());
   for (uint32_t t = 0; t < dt.TetCapacity(); ++t) {
@@ -170,19 +169,30 @@ absl::StatusOr<PointSetResult> TetrahedralizePointSet(std::span<const geom::Vec3
     std::array<uint32_t, 4> tv;
     for (int i = 0; i < 4; ++i) tv[i] = dt.GlobalId(dt.TetVertex(tid, i));
     rotated.push_back(CanonicalRotation(tv));
-    ++bucket_start[rotated.back()[0] + 1];
   }
-  for (size_t i = 0; i < n; ++i) bucket_start[i + 1] += bucket_start[i];
   result.tets.resize(rotated.size());
-  {
-    std::vector<uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
-    for (const auto& tv : rotated) result.tets[fill[tv[0]]++] = tv;
+  constexpr int kDigit = 11;
+  constexpr uint32_t kRadix = 1u << kDigit;
+  std::vector<uint32_t> count(kRadix);
+  for (int shift = 0; shift < 32 && (n - 1) >> shift != 0; shift += kDigit) {
+    std::fill(count.begin(), count.end(), 0);
+    for (const auto& tv : rotated) ++count[(tv[0] >> shift) & (kRadix - 1)];
+    uint32_t acc = 0;
+    for (uint32_t& c : count) {
+      const uint32_t k = c;
+      c = acc;
+      acc += k;
+    }
+    for (const auto& tv : rotated) result.tets[count[(tv[0] >> shift) & (kRadix - 1)]++] = tv;
+    rotated.swap(result.tets);
   }
+  result.tets.swap(rotated);  // the last pass's output
   rotated = {};
-  for (size_t i = 0; i < n; ++i) {
-    auto first = result.tets.begin() + bucket_start[i];
-    auto last = result.tets.begin() + bucket_start[i + 1];
-    if (last - first > 1) std::sort(first, last);
+  for (size_t i = 0; i < result.tets.size();) {
+    size_t j = i + 1;
+    while (j < result.tets.size() && result.tets[j][0] == result.tets[i][0]) ++j;
+    if (j - i > 1) std::sort(result.tets.begin() + i, result.tets.begin() + j);
+    i = j;
   }
   result.seconds_output = SecondsSince(t0);
   return result;
