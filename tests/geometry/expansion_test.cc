@@ -3,7 +3,9 @@
 
 #include <gmpxx.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -78,6 +80,41 @@ TEST(ExpansionTest, RandomPolynomialsMatchGmp) {
     ASSERT_EQ(Exact(e), q);
     ASSERT_EQ(e.Sign(), sgn(q));
   }
+}
+
+// Long expansions (beyond the inline buffer) through copies and moves.
+TEST(ExpansionTest, LongExpansionsCopyAndMove) {
+  std::mt19937_64 rng(3);
+  Expansion e;
+  mpq_class q = 0;
+  size_t longest = 0;
+  // Words spread over 2^-900..2^900: sums stay exact, and long.
+  for (int i = 0; i < 400; ++i) {
+    const double a = RandomDouble(rng) * std::ldexp(1.0, 9 * (i % 200) - 900);
+    e += Expansion(a);
+    q += mpq_class(a);
+    longest = std::max(longest, e.size());
+  }
+  ASSERT_GT(longest, 40u);  // exercised the heap storage
+  Expansion copy = e;
+  Expansion moved = std::move(copy);
+  Expansion assigned;
+  assigned = moved;
+  assigned = assigned;  // self-assignment keeps the value
+  ExpectWellFormed(assigned);
+  EXPECT_EQ(Exact(assigned), q);
+  EXPECT_EQ(Exact(moved), q);
+  EXPECT_EQ((assigned - e).Sign(), 0);
+  // Products on a moderate exponent range (no underflow).
+  Expansion f;
+  mpq_class r = 0;
+  for (int i = 0; i < 60; ++i) {
+    const double a = RandomDouble(rng) * std::ldexp(1.0, 8 * (i % 30) - 120), b = RandomDouble(rng);
+    f += Expansion::Product(a, b);
+    r += mpq_class(a) * mpq_class(b);
+  }
+  EXPECT_EQ(Exact(f * f), r * r);
+  EXPECT_EQ(Exact(f * (-f)), -(r * r));
 }
 
 TEST(ExpansionTest, CancellationGivesExactZero) {
