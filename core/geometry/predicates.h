@@ -13,7 +13,11 @@
 //      by a power of two so that no intermediate product over/underflows. If
 //      the coordinates' binary exponents span too wide a range for that (about
 //      2000/degree orders of two, e.g. 1e120 next to a denormal), GMP rationals
-//      evaluate the same polynomial instead. Exact for all finite inputs;
+//      evaluate the same polynomial instead. Before either, a fast exact path
+//      for "nice" inputs (grids): when all coordinate differences are exact
+//      and are small integers times one power of two, the double formula is
+//      itself exact (predicates.cc, SmallDyadicDiffs). Exact for all finite
+//      inputs;
 //   3. for the *SoS variants, when the exact value is 0, simulation of
 //      simplicity by caller-supplied global ids (see the SoS section below).
 //
