@@ -66,6 +66,7 @@ absl::StatusOr<v1::Job> RemoteClient::SubmitOnce(const v1::SubmitJobRequest& req
   v1::UploadJobRequest header;
   *header.mutable_header() = request;
   header.mutable_header()->mutable_file()->clear_data();
+  header.set_total_bytes(request.file().data().size());
   bool ok = writer->Write(header);
   const std::string& data = request.file().data();
   v1::UploadJobRequest chunk;

@@ -4,6 +4,7 @@
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
 #include "grpcpp/health_check_service_interface.h"
 #include "grpcpp/security/server_credentials.h"
+#include "grpc/grpc.h"
 #include "grpcpp/server_builder.h"
 #include "server/log.h"
 
@@ -36,11 +37,14 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
+  // Without this, a second server on a busy port would share it silently.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &server->port_);
   builder.RegisterService(server->service_.get());
   server->grpc_server_ = builder.BuildAndStart();
   if (server->grpc_server_ == nullptr || server->port_ == 0) {
     server->manager_->Shutdown(absl::ZeroDuration());
+    server->shut_down_ = true;
     return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
   }
   server->address_ = absl::StrCat(options.listen.substr(0, colon), ":", server->port_);

@@ -28,8 +28,9 @@ grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context,
 // when the client half-closes.
 class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest> {
  public:
-  UploadReactor(JobManager* manager, uint64_t max_bytes, v1::Job* response)
-      : manager_(manager), max_bytes_(max_bytes), response_(response) {
+  UploadReactor(grpc::CallbackServerContext* context, JobManager* manager, uint64_t max_bytes,
+                v1::Job* response)
+      : context_(context), manager_(manager), max_bytes_(max_bytes), response_(response) {
     StartRead(&message_);
   }
 
@@ -46,6 +47,14 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
         return;
       }
       request_ = std::move(*message_.mutable_header());
+      total_bytes_ = message_.total_bytes();
+      if (total_bytes_ > max_bytes_) {
+        Finish(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                            absl::StrCat("upload of ", total_bytes_, " bytes exceeds the server's limit of ",
+                                         max_bytes_, " bytes")));
+        return;
+      }
+      request_.mutable_file()->mutable_data()->reserve(total_bytes_);
       have_header_ = true;
     } else {
       if (message_.part_case() != v1::UploadJobRequest::kChunk) {
@@ -70,8 +79,18 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
 
  private:
   void Submit() {
+    if (context_->IsCancelled()) {
+      Finish(grpc::Status::CANCELLED);
+      return;
+    }
     if (!have_header_) {
       Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, "empty upload: no header"));
+      return;
+    }
+    const uint64_t got = request_.file().data().size();
+    if (total_bytes_ != 0 && got != total_bytes_) {
+      Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          absl::StrCat("upload ended after ", got, " of ", total_bytes_, " bytes")));
       return;
     }
     absl::StatusOr<v1::Job> job = manager_->Submit(std::move(request_));
@@ -79,8 +98,10 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
     Finish(ToGrpcStatus(job.status()));
   }
 
+  grpc::CallbackServerContext* context_;
   JobManager* manager_;
   const uint64_t max_bytes_;
+  uint64_t total_bytes_ = 0;
   v1::Job* response_;
   v1::UploadJobRequest message_;
   v1::SubmitJobRequest request_;
@@ -210,7 +231,10 @@ class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
   }
 
   void OnWriteDone(bool ok) override {
-    if (!ok) return;
+    if (!ok) {  // the client went away: every RPC must still be finished
+      Finish(grpc::Status::CANCELLED);
+      return;
+    }
     NextChunk();
   }
 
@@ -258,7 +282,7 @@ grpc::ServerUnaryReactor* MeshingServiceImpl::SubmitJob(grpc::CallbackServerCont
 
 grpc::ServerReadReactor<v1::UploadJobRequest>* MeshingServiceImpl::UploadJob(
     grpc::CallbackServerContext* context, v1::Job* response) {
-  return new UploadReactor(manager_, max_upload_bytes_, response);
+  return new UploadReactor(context, manager_, max_upload_bytes_, response);
 }
 
 grpc::ServerWriteReactor<v1::JobEvent>* MeshingServiceImpl::WatchJob(

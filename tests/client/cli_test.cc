@@ -1,0 +1,168 @@
+// The `svrc` CLI binary against a real server: local and remote outputs are
+// byte-identical in every output format; the job id is submit's last stdout
+// line; get/list/cancel/health work; exit statuses follow client/command.h
+// (2 usage, 3 invalid input, 4 server, 5 job failed, 6 cancelled/deadline).
+#include <filesystem>
+#include <map>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "gtest/gtest.h"
+#include "tests/server/service_test_util.h"
+#include "tests/test_support.h"
+
+namespace svrc {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RunSvrc;
+using testing::ServerProcess;
+
+// Every file in `dir`, by name → bytes.
+std::map<std::string, std::string> DirFiles(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    out[e.path().filename().string()] = testing::ReadFileOrFail(e.path().string());
+  }
+  return out;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { server_ = new ServerProcess({"--workers=2"}); }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  static ServerProcess* server_;
+};
+ServerProcess* CliTest::server_ = nullptr;
+
+TEST_F(CliTest, LocalAndRemoteOutputsAreByteIdentical) {
+  ASSERT_TRUE(server_->ok());
+  const std::string dir = testing::MakeTempDir("cli_identity");
+  const std::string input = dir + "/points.node";
+  testing::WriteFileOrDie(input, testing::RandomNodeFile(5000, 21));
+  for (const char* ext : {".node", ".vtu", ".msh", ".mesh", ".svrc"}) {
+    SCOPED_TRACE(ext);
+    const std::string local_dir = dir + "/local" + ext, remote_dir = dir + "/remote" + ext;
+    fs::create_directories(local_dir);
+    fs::create_directories(remote_dir);
+    testing::CommandResult local =
+        RunSvrc({"mesh", input, "-o", local_dir + "/out" + ext, "--quiet"});
+    ASSERT_EQ(local.exit_code, 0) << local.err;
+    testing::CommandResult remote = RunSvrc({"submit", input, "--server", server_->address(),
+                                             "--watch", "-o", remote_dir + "/out" + ext});
+    ASSERT_EQ(remote.exit_code, 0) << remote.err;
+    std::map<std::string, std::string> a = DirFiles(local_dir), b = DirFiles(remote_dir);
+    ASSERT_FALSE(a.empty());
+    EXPECT_EQ(a.size(), b.size());
+    for (const auto& [name, bytes] : a) {
+      ASSERT_TRUE(b.count(name)) << name << " missing remotely";
+      EXPECT_TRUE(bytes == b[name]) << name << " differs (" << bytes.size() << " vs "
+                                    << b[name].size() << " bytes)";
+    }
+  }
+  EXPECT_TRUE(fs::exists(dir + "/local.node/out.ele"));
+  EXPECT_TRUE(fs::exists(dir + "/local.node/out.face"));
+}
+
+TEST_F(CliTest, SubmitPrintsTheJobIdThenGetListAndHealthWork) {
+  ASSERT_TRUE(server_->ok());
+  const std::string dir = testing::MakeTempDir("cli_submit");
+  const std::string input = dir + "/p.node";
+  testing::WriteFileOrDie(input, testing::RandomNodeFile(300, 22));
+  testing::CommandResult sub = RunSvrc({"submit", input, "--server", server_->address()});
+  ASSERT_EQ(sub.exit_code, 0) << sub.err;
+  const std::string id = testing::LastLine(sub.out);
+  ASSERT_EQ(id.size(), 17u) << sub.out;
+  testing::CommandResult watch = RunSvrc({"watch", id, "--server", server_->address()});
+  EXPECT_EQ(watch.exit_code, 0) << watch.err;
+  EXPECT_NE(watch.out.find("SUCCEEDED"), std::string::npos) << watch.out;
+  testing::CommandResult get = RunSvrc({"get", id, "--server", server_->address(), "-o", dir + "/r.vtu"});
+  EXPECT_EQ(get.exit_code, 0) << get.err;
+  EXPECT_TRUE(fs::exists(dir + "/r.vtu"));
+  testing::CommandResult list = RunSvrc({"list", "--server", server_->address(), "--state", "SUCCEEDED"});
+  EXPECT_EQ(list.exit_code, 0) << list.err;
+  EXPECT_NE(list.out.find(id), std::string::npos) << list.out;
+  testing::CommandResult health = RunSvrc({"health", "--server", server_->address()});
+  EXPECT_EQ(health.exit_code, 0) << health.err;
+  EXPECT_EQ(testing::LastLine(health.out), "SERVING");
+  // Same --request-id: same job.
+  testing::CommandResult r1 = RunSvrc({"submit", input, "--server", server_->address(), "--request-id", "cli-rid-1"});
+  testing::CommandResult r2 = RunSvrc({"submit", input, "--server", server_->address(), "--request-id", "cli-rid-1"});
+  EXPECT_EQ(testing::LastLine(r1.out), testing::LastLine(r2.out));
+  testing::CommandResult del = RunSvrc({"delete", id, "--server", server_->address()});
+  EXPECT_EQ(del.exit_code, 0) << del.err;
+  EXPECT_EQ(RunSvrc({"get", id, "--server", server_->address()}).exit_code, 4);
+}
+
+TEST_F(CliTest, ExitStatuses) {
+  ASSERT_TRUE(server_->ok());
+  const std::string dir = testing::MakeTempDir("cli_exit");
+  const std::string bad = testing::CorpusPath("g_bad/bad_dangling_index.poly");
+  const std::string cube = testing::CorpusPath("a_convex/cube.poly");
+  const std::string points = dir + "/p.node";
+  testing::WriteFileOrDie(points, testing::RandomNodeFile(200, 23));
+
+  EXPECT_EQ(RunSvrc({}).exit_code, 2);
+  EXPECT_EQ(RunSvrc({"frobnicate"}).exit_code, 2);
+  EXPECT_EQ(RunSvrc({"mesh", points}).exit_code, 2);  // no -o
+  EXPECT_EQ(RunSvrc({"mesh", points, "-o", dir + "/x.vtu", "--radius-edge", "abc"}).exit_code, 2);
+  EXPECT_EQ(RunSvrc({"submit", points, "--no-such-flag"}).exit_code, 2);
+
+  testing::CommandResult local_bad = RunSvrc({"mesh", bad, "-o", dir + "/b.vtu"});
+  EXPECT_EQ(local_bad.exit_code, 3);
+  EXPECT_NE(local_bad.err.find("42"), std::string::npos) << local_bad.err;
+  EXPECT_EQ(std::count(local_bad.err.begin(), local_bad.err.end(), '\n'), 1) << local_bad.err;
+  testing::CommandResult remote_bad = RunSvrc({"submit", bad, "--server", server_->address(), "--watch"});
+  EXPECT_EQ(remote_bad.exit_code, 3) << remote_bad.err;
+  EXPECT_NE(remote_bad.err.find("INVALID_ARGUMENT"), std::string::npos) << remote_bad.err;
+  EXPECT_EQ(RunSvrc({"mesh", dir + "/missing.node", "-o", dir + "/m.vtu"}).exit_code, 3);
+
+  // Unreachable server: 4 (a port nothing listens on: the server's own, after it is gone).
+  {
+    ServerProcess gone;
+    ASSERT_TRUE(gone.ok());
+    const std::string addr = gone.address();
+    gone.Terminate(30);
+    EXPECT_EQ(RunSvrc({"health", "--server", addr}).exit_code, 4);
+    EXPECT_EQ(RunSvrc({"submit", points, "--server", addr}).exit_code, 4);
+  }
+
+  // A job that fails: PLC meshing is UNIMPLEMENTED for now (5) — or, once it
+  // lands, succeeds (0). A refinement parameter on a point set: 5.
+  const int cube_code = RunSvrc({"submit", cube, "--server", server_->address(), "--watch"}).exit_code;
+  EXPECT_TRUE(cube_code == 5 || cube_code == 0) << cube_code;
+  testing::CommandResult unimpl =
+      RunSvrc({"submit", points, "--server", server_->address(), "--watch", "--max-volume", "0.1"});
+  EXPECT_EQ(unimpl.exit_code, 5) << unimpl.err;
+  EXPECT_NE(unimpl.err.find("UNIMPLEMENTED"), std::string::npos) << unimpl.err;
+  EXPECT_EQ(RunSvrc({"mesh", points, "-o", dir + "/u.vtu", "--max-volume", "0.1"}).exit_code, 5);
+
+  // Deadline exceeded (6), remotely and locally.
+  const std::string big = dir + "/big.node";
+  testing::WriteFileOrDie(big, testing::RandomNodeFile(400000, 24));
+  testing::CommandResult late =
+      RunSvrc({"submit", big, "--server", server_->address(), "--watch", "--deadline", "0.3s"});
+  EXPECT_EQ(late.exit_code, 6) << late.err;
+  EXPECT_NE(late.err.find("DEADLINE_EXCEEDED"), std::string::npos) << late.err;
+  EXPECT_EQ(RunSvrc({"mesh", big, "-o", dir + "/late.vtu", "--deadline", "0.3", "--quiet"}).exit_code, 6);
+
+  // Cancelled (6): watch a job that another command cancels.
+  testing::CommandResult sub = RunSvrc({"submit", big, "--server", server_->address()});
+  ASSERT_EQ(sub.exit_code, 0) << sub.err;
+  const std::string id = testing::LastLine(sub.out);
+  EXPECT_EQ(RunSvrc({"cancel", id, "--server", server_->address()}).exit_code, 0);
+  EXPECT_EQ(RunSvrc({"watch", id, "--server", server_->address()}).exit_code, 6);
+  EXPECT_EQ(RunSvrc({"get", id, "--server", server_->address(), "-o", dir + "/c.vtu"}).exit_code, 6);
+}
+
+TEST(CliVersionTest, PrintsTheVersion) {
+  testing::CommandResult v = RunSvrc({"--version"});
+  EXPECT_EQ(v.exit_code, 0);
+  EXPECT_TRUE(absl::StartsWith(v.out, "svrc ")) << v.out;
+}
+
+}  // namespace
+}  // namespace svrc
