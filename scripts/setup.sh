@@ -20,7 +20,7 @@ TEST_PKGS=(
   zlib1g-dev
 )
 RUNTIME_PKGS=(
-  libabsl20220623 libspdlog1.10 libdraco7 libgrpc++1.51 libprotobuf32 ca-certificates
+  libabsl20220623 libspdlog1.10 libdraco7 libgrpc++1.51 libprotobuf32 libgmp10 ca-certificates
 )
 
 if [[ "${1:-}" == "--runtime" ]]; then
