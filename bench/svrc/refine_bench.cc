@@ -5,7 +5,9 @@
 //             output must grow like log Δ;
 //   random n: n uniform points in the unit cube.
 // Prints vertices, tets, time, and the per-run counters of RefineStats.
-// Usage: svrc_refine_bench skew 1000 | pair 12 | random 10000 [tau]
+//   comb  n : n parallel unit segments 10^-3 apart (stage (b));
+//   nearseg k: a unit segment and a point 10^-k from its midpoint.
+// Usage: svrc_refine_bench skew 1000 | pair 12 | random 10000 | comb 4 | nearseg 6 [tau]
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +27,7 @@ int main(int argc, char** argv) {
   svrc::refine::RefineOptions options;
   if (argc > 3) options.tau = std::atof(argv[3]);
   std::vector<svrc::geom::Vec3> pts;
+  std::vector<svrc::refine::SegmentInput> segs;
   if (kind == "skew") {
     for (int i = 0; i < n; ++i) pts.push_back({0, double(i) / n, 0});
     for (int i = 0; i < n; ++i) pts.push_back({double(i) / n, 0, 1});
@@ -32,23 +35,36 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 8; ++i) pts.push_back({double(i & 1), double((i >> 1) & 1), double(i >> 2)});
     pts.push_back({0.5, 0.5, 0.5});
     pts.push_back({0.5, 0.5, 0.5 + std::pow(10.0, -n)});
+  } else if (kind == "comb") {
+    // n parallel unit segments 10^-3 apart (free segments, stage (b)).
+    for (int i = 0; i < n; ++i) {
+      pts.push_back({0, 0, 1e-3 * i});
+      pts.push_back({1, 0, 1e-3 * i});
+      segs.push_back({uint32_t(2 * i), uint32_t(2 * i + 1)});
+    }
+  } else if (kind == "nearseg") {
+    // A unit segment and a point 10^-n from its midpoint.
+    pts = {{0, 0, 0}, {1, 0, 0}, {0.5, std::pow(10.0, -n), 0}};
+    segs.push_back({0, 1});
   } else {
     std::mt19937_64 rng(1);
     std::uniform_real_distribution<double> u(0, 1);
     for (int i = 0; i < n; ++i) pts.push_back({u(rng), u(rng), u(rng)});
   }
-  auto r = svrc::refine::RefinePointSet(pts, options);
+  auto r = svrc::refine::RefinePointsAndSegments(pts, segs, options);
   if (!r.ok()) {
     std::fprintf(stderr, "%s\n", r.status().ToString().c_str());
     return 1;
   }
   const auto& s = r->stats;
   std::printf(
-      "%s %d tau=%.2f: inputs=%zu vertices=%llu tets=%zu seconds=%.3f us/vertex=%.2f warps=%llu "
+      "%s %d tau=%.2f: inputs=%zu vertices=%llu (segment %llu, yields %llu, encroached %llu) tets=%zu seconds=%.3f us/vertex=%.2f warps=%llu "
       "max_degree=%u max_aspect=%.3f buckets_walked=%llu max_walk=%llu links=%llu/%llu "
       "destroy_cells_avg=%.1f max=%llu clipped=%llu skinny=%llu/%llu stale unresolved=%llu/%llu stale "
       "pred_exact=%llu/%llu sos=%llu\n",
-      kind.c_str(), n, options.tau, pts.size(), (unsigned long long)s.vertices, r->tets.size(),
+      kind.c_str(), n, options.tau, pts.size(), (unsigned long long)s.vertices,
+      (unsigned long long)s.segment_vertices, (unsigned long long)s.yields,
+      (unsigned long long)s.events_popped[1], r->tets.size(),
       s.seconds, 1e6 * s.seconds / double(s.vertices), (unsigned long long)s.warps, s.max_degree,
       s.max_aspect, (unsigned long long)s.buckets_walked, (unsigned long long)s.max_bucket_walk,
       (unsigned long long)s.links_added, (unsigned long long)s.links_removed,

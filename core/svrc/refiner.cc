@@ -156,6 +156,27 @@ absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<con
     fs.is_free = true;
     complex.segments.push_back(fs);
   }
+  // Two segments meeting at a point at less than 90° make that point a crease
+  // (Definitions 4–5): without collars (stage (d)) refinement around it would
+  // never stop, so such inputs are refused rather than run to the budget.
+  {
+    std::vector<std::vector<uint32_t>> other_end(num_input_);
+    for (const plc::FeatureSegment& fs : complex.segments) {
+      other_end[fs.a].push_back(fs.b);
+      other_end[fs.b].push_back(fs.a);
+    }
+    for (uint32_t o = 0; o < num_input_; ++o) {
+      const auto& ends = other_end[o];
+      for (size_t i = 0; i < ends.size(); ++i) {
+        for (size_t j = i + 1; j < ends.size(); ++j) {
+          if (geom::DotSign(normalised[o], normalised[ends[i]], normalised[o], normalised[ends[j]]) > 0) {
+            return absl::UnimplementedError(absl::StrCat(
+                "SVRC: segments at point ", o, " meet at an acute angle (a crease); collars are not implemented yet"));
+          }
+        }
+      }
+    }
+  }
   features_ = FeatureTable::Build(complex);
   seg_mesh0_ = segments.empty() ? 0 : features_.OfSegment(0).value();
   budget_ = options_.max_vertices != 0 ? options_.max_vertices

@@ -104,7 +104,8 @@ struct SegmentInput {
 // Stage (b): points and free segments. The segments must be a valid complex
 // with the points ("plc" validates PLCs): distinct endpoints, no point of the
 // input strictly inside a segment, segments meeting only at endpoints.
-// INVALID_ARGUMENT for endpoint ids out of range or equal. At the end every
+// INVALID_ARGUMENT for endpoint ids out of range or equal; UNIMPLEMENTED when
+// two segments meet at an acute angle (a crease: needs collars, stage (d)). At the end every
 // segment is a chain of M_Ω edges (`segment_chains`) and every cell of M_Ω and
 // of each segment mesh has R_v/r_v ≤ τ.
 absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const geom::Vec3> points,

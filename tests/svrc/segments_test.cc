@@ -123,6 +123,29 @@ TEST(SegmentsTest, SkewSegmentsAndYield) {
   ExpectConformingSegments(pts, segs, *r, 4.0);
 }
 
+// A comb of parallel segments 0.05 apart (each must be split into ~1/0.05
+// pieces: local feature size), and an obtuse (120°) corner: graded 1D meshes
+// that agree with M_Ω.
+TEST(SegmentsTest, CloseParallelSegmentsAndObtuseCorner) {
+  std::vector<Vec3> pts;
+  std::vector<SegmentInput> segs;
+  for (int i = 0; i < 3; ++i) {
+    pts.push_back({0, 0, 0.05 * i});
+    pts.push_back({1, 0, 0.05 * i});
+    segs.push_back({uint32_t(2 * i), uint32_t(2 * i + 1)});
+  }
+  const uint32_t o = static_cast<uint32_t>(pts.size());
+  pts.push_back({0, 1, 0});
+  pts.push_back({1, 1, 0});
+  pts.push_back({-0.5, 1 + std::sqrt(0.75), 0});
+  segs.push_back({o, o + 1});
+  segs.push_back({o, o + 2});
+  auto r = RefinePointsAndSegments(pts, segs, Checked(211));
+  ASSERT_TRUE(r.ok()) << r.status();
+  ExpectConformingSegments(pts, segs, *r, 4.0);
+  EXPECT_GE(r->segment_chains[1].size(), 10u);
+}
+
 TEST(SegmentsTest, DeterministicAndRejectsBadSegments) {
   std::vector<Vec3> pts = {{0, 0, 0}, {1, 0, 0}, {0.2, 0.1, 0.3}, {0.9, 0.8, -0.4}};
   std::vector<SegmentInput> segs = {{0, 1}, {2, 3}};
@@ -134,6 +157,9 @@ TEST(SegmentsTest, DeterministicAndRejectsBadSegments) {
   EXPECT_EQ(a->segment_chains, b->segment_chains);
   std::vector<SegmentInput> bad = {{0, 7}};
   EXPECT_EQ(RefinePointsAndSegments(pts, bad, {}).status().code(), absl::StatusCode::kInvalidArgument);
+  // An acute corner is a crease (Definition 5): refused until collars exist.
+  std::vector<SegmentInput> acute = {{0, 1}, {0, 2}};
+  EXPECT_EQ(RefinePointsAndSegments(pts, acute, {}).status().code(), absl::StatusCode::kUnimplemented);
   std::vector<SegmentInput> loop = {{1, 1}};
   EXPECT_EQ(RefinePointsAndSegments(pts, loop, {}).status().code(), absl::StatusCode::kInvalidArgument);
 }
