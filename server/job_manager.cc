@@ -259,6 +259,7 @@ void JobManager::Notify(JobRecord* rec) {
 void JobManager::Finish(JobRecord* rec, const absl::Status& status) {
   v1::Job& job = rec->job;
   job.set_state(StateFor(status));
+  if (status.ok()) job.mutable_progress()->set_phase("done");
   if (!status.ok()) *job.mutable_error() = ToProtoStatus(status);
   rec->ended = absl::Now();
   *job.mutable_end_time() = ToTimestamp(rec->ended);
