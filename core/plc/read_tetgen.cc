@@ -227,6 +227,9 @@ absl::Status ReadTetgen(std::string_view bytes, InputFormat format, Plc* plc,
       if (m < INT32_MIN || m > INT32_MAX) return r.Error(Cat("marker ", m, " out of range"));
       facet.marker = static_cast<int32_t>(m);
       for (int64_t p = 0; p < np; ++p) {
+        // As in TetGen, each polygon starts on a new line (its corners may
+        // continue on the following ones); the rest of a line is ignored.
+        r.SkipRestOfLine();
         int64_t k = 0;
         if (absl::Status s = r.NextInt("the number of polygon corners", &k); !s.ok()) return s;
         Polygon poly;
@@ -234,6 +237,7 @@ absl::Status ReadTetgen(std::string_view bytes, InputFormat format, Plc* plc,
         facet.polygons.push_back(std::move(poly));
       }
       for (int64_t h = 0; h < nh; ++h) {
+        r.SkipRestOfLine();
         int64_t id = 0;
         if (absl::Status s = r.NextInt("a facet hole number", &id); !s.ok()) return s;
         Vec3 p;

@@ -193,6 +193,22 @@ TEST(Readers, PolyDetails) {
   EXPECT_EQ(fan.facets[1].polygons[1].vertices.size(), 2u);
 }
 
+TEST(Readers, PolyFacetLinesAsTetgenReadsThem) {
+  // Marker flag 0 with a marker present on the facet line (ignored, as in
+  // TetGen), a polygon continued on the next line, a facet hole.
+  const std::string poly =
+      "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n"
+      "1 0\n2 1 7\n4 1 2\n 3 4\n2 2 4\n1 0.9 0.1 0\n";
+  absl::StatusOr<Plc> plc = ReadPlcBytes(poly, InputFormat::kPoly, "t.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  ASSERT_EQ(plc->facets.size(), 1u);
+  EXPECT_EQ(plc->facets[0].marker, 0);
+  EXPECT_EQ(plc->facets[0].polygons[0].vertices, (std::vector<uint32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(plc->facets[0].polygons[1].vertices, (std::vector<uint32_t>{1, 3}));
+  ASSERT_EQ(plc->facets[0].holes.size(), 1u);
+  EXPECT_EQ(plc->facets[0].holes[0], Vec3(0.9, 0.1, 0));
+}
+
 TEST(Readers, StlSolidNamesBecomeMarkers) {
   const std::string two =
       "solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
