@@ -249,3 +249,49 @@ TEST(Features, ExampleHoleAndRegions) {
 
 }  // namespace
 }  // namespace svrc::plc
+
+namespace svrc::plc {
+namespace {
+
+double TriArea(const FeatureComplex& fc, const std::array<PointId, 3>& t) {
+  return 0.5 * geom::Norm(geom::Cross(fc.points[t[1]].p - fc.points[t[0]].p,
+                                      fc.points[t[2]].p - fc.points[t[0]].p));
+}
+
+double LoopArea(const FeatureComplex& fc, const std::vector<PointId>& loop) {
+  geom::Vec3 n;
+  for (size_t i = 0; i < loop.size(); ++i) {
+    n += geom::Cross(fc.points[loop[i]].p, fc.points[loop[(i + 1) % loop.size()]].p);
+  }
+  return 0.5 * geom::Norm(n);
+}
+
+// Each facet's triangulation covers exactly its pieces minus its holes.
+TEST(Features, TriangulationsCoverFacetsMinusHoles) {
+  for (const char* rel : {"f_real/hinge.stl", "b_internal/example.poly", "c_creases/knife_edge.poly",
+                          "d_small_angles/segment_fan.poly"}) {
+    SCOPED_TRACE(rel);
+    const FeatureComplex fc = MustBuildFile(rel);
+    size_t with_holes = 0;
+    for (const FeatureFacet& f : fc.facets) {
+      double tri = 0, expect = 0;
+      for (const auto& t : f.triangles) tri += TriArea(fc, t);
+      size_t holes = 0;
+      for (size_t l = 0; l < f.loops.size(); ++l) {
+        if (f.loop_is_hole[l]) {
+          expect -= LoopArea(fc, f.loops[l]);
+          ++holes;
+        } else if (l == 0) {
+          expect += LoopArea(fc, f.loops[l]);  // pieces here: the first loop only
+        }
+      }
+      EXPECT_EQ(holes, f.holes.size());
+      with_holes += holes;
+      EXPECT_NEAR(tri, expect, 1e-9 * std::max(1.0, expect));
+    }
+    if (std::string(rel) == "f_real/hinge.stl") EXPECT_EQ(with_holes, 7u);  // 7 merged-facet holes
+  }
+}
+
+}  // namespace
+}  // namespace svrc::plc
