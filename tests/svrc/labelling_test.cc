@@ -1,0 +1,311 @@
+// Region labelling (core/svrc/labelling.h): components, seeds, holes, ∂Ω,
+// constrained faces, warnings and errors, on Kuhn grids where the expected
+// answer follows from each tet's centroid.
+#include "core/svrc/labelling.h"
+
+#include <algorithm>
+#include <random>
+
+#include "core/geometry/predicates.h"
+#include "gtest/gtest.h"
+#include "tests/svrc/output_test_util.h"
+
+namespace svrc::refine {
+namespace {
+
+using geom::Vec3;
+using testing::ConvexFacet;
+using testing::Grid;
+
+Vec3 Centroid(const Grid& g, const std::array<uint32_t, 4>& t) {
+  return (g.positions[t[0]] + g.positions[t[1]] + g.positions[t[2]] + g.positions[t[3]]) / 4.0;
+}
+
+bool Inside(const Vec3& p, double lo, double hi) {
+  return p.x > lo && p.x < hi && p.y > lo && p.y < hi && p.z > lo && p.z < hi;
+}
+
+bool HasIssue(const Labelling& l, LabelIssueKind k) {
+  return std::any_of(l.issues.begin(), l.issues.end(), [&](const LabelIssue& i) { return i.kind == k; });
+}
+
+// Three nested boxes in an 8^3 grid (Ω = [0,8]^3): outer [1,7] (marker 1),
+// middle [2,6] (marker 2), inner [3,5] (marker 3).
+struct Nested {
+  Grid grid = testing::KuhnGrid(8);
+  plc::Plc plc;
+  std::vector<ConstrainedFace> faces;
+  Nested() {
+    testing::AddBox(&plc, {1, 1, 1}, {7, 7, 7}, 1);
+    testing::AddBox(&plc, {2, 2, 2}, {6, 6, 6}, 2);
+    testing::AddBox(&plc, {3, 3, 3}, {5, 5, 5}, 3);
+    faces = testing::FacesOnConvexFacets(grid.positions, grid.tets,
+                                         testing::ConvexFacetsOf(plc, CoordinateMap{}));
+  }
+  LabelInput Input(std::span<const plc::RegionSeed> seeds, std::span<const Vec3> holes,
+                   bool keep = false) const {
+    LabelInput in;
+    in.positions = grid.positions;
+    in.tets = grid.tets;
+    in.constrained_faces = faces;
+    in.region_seeds = seeds;
+    in.hole_seeds = holes;
+    in.keep_bounding_box = keep;
+    return in;
+  }
+};
+
+// The plane marker of a face of the nested boxes, from its coordinates.
+int32_t ExpectedMarker(const Grid& g, const std::array<uint32_t, 3>& v) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const double c = g.positions[v[0]][axis];
+    if (g.positions[v[1]][axis] != c || g.positions[v[2]][axis] != c) continue;
+    if (c == 1 || c == 7) return 1;
+    if (c == 2 || c == 6) return 2;
+    if (c == 3 || c == 5) return 3;
+  }
+  return -1;
+}
+
+TEST(LabellingTest, NestedBoxesTwoRegionsAndAHole) {
+  Nested nb;
+  EXPECT_EQ(nb.faces.size(), 6u * (36 + 16 + 4) * 2);
+  const std::vector<plc::RegionSeed> seeds = {{{1.5, 1.5, 1.5}, 10, 0}, {{2.5, 2.6, 2.7}, 20, 0.5}};
+  const std::vector<Vec3> holes = {{4.1, 4.2, 4.3}};
+  auto l = LabelRegions(nb.Input(seeds, holes));
+  ASSERT_TRUE(l.ok()) << l.status();
+  EXPECT_TRUE(l->issues.empty()) << l->issues[0].message;
+  EXPECT_EQ(l->components.size(), 4u);
+  uint32_t kept = 0;
+  for (size_t t = 0; t < nb.grid.tets.size(); ++t) {
+    const Vec3 c = Centroid(nb.grid, nb.grid.tets[t]);
+    const Component& comp = l->components[l->tet_component[t]];
+    if (Inside(c, 3, 5) || !Inside(c, 1, 7)) {
+      EXPECT_FALSE(comp.kept) << "tet " << t;
+      continue;
+    }
+    ++kept;
+    ASSERT_TRUE(comp.kept) << "tet " << t;
+    if (Inside(c, 2, 6)) {
+      EXPECT_EQ(comp.attribute, 20);
+      EXPECT_EQ(comp.max_volume, 0.5);
+      EXPECT_EQ(comp.seed, 1);
+    } else {
+      EXPECT_EQ(comp.attribute, 10);
+      EXPECT_EQ(comp.seed, 0);
+    }
+  }
+  EXPECT_EQ(kept, (216u - 8u) * 6u);
+  EXPECT_EQ(l->num_kept_tets, kept);
+  // Every constrained face has a kept side here: outer (kept|exterior),
+  // middle (kept|kept), inner (kept|hole).
+  ASSERT_EQ(l->faces.size(), nb.faces.size());
+  for (const LabelledFace& f : l->faces) {
+    EXPECT_EQ(f.marker, ExpectedMarker(nb.grid, f.v));
+    EXPECT_TRUE(l->Kept(f.tets[0]));
+    const bool interface = f.marker == 2;
+    ASSERT_NE(f.tets[1], kNoTet);  // Ω's interior: every face has two tets
+    EXPECT_EQ(l->Kept(f.tets[1]), interface);
+  }
+  // Components are numbered by their smallest tet.
+  for (size_t c = 0; c < l->components.size(); ++c) {
+    EXPECT_EQ(l->tet_component[l->components[c].first_tet], c);
+    for (size_t t = 0; t < l->components[c].first_tet; ++t) EXPECT_LT(l->tet_component[t], c);
+  }
+  EXPECT_TRUE(l->components[0].touches_box);  // tet 0 is at the grid corner
+}
+
+TEST(LabellingTest, KeepBoundingBoxKeepsEverything) {
+  Nested nb;
+  const std::vector<plc::RegionSeed> seeds = {{{2.5, 2.6, 2.7}, 20, 0}};
+  const std::vector<Vec3> holes = {{4.1, 4.2, 4.3}};
+  auto l = LabelRegions(nb.Input(seeds, holes, /*keep=*/true));
+  ASSERT_TRUE(l.ok()) << l.status();
+  EXPECT_EQ(l->num_kept_tets, nb.grid.tets.size());
+  EXPECT_TRUE(HasIssue(*l, LabelIssueKind::kHoleSeedsIgnored));
+  EXPECT_EQ(l->faces.size(), nb.faces.size());
+  for (size_t t = 0; t < nb.grid.tets.size(); ++t) {
+    const Vec3 c = Centroid(nb.grid, nb.grid.tets[t]);
+    const bool middle = Inside(c, 2, 6) && !Inside(c, 3, 5);
+    EXPECT_EQ(l->components[l->tet_component[t]].attribute, middle ? 20 : 0);
+  }
+}
+
+TEST(LabellingTest, UnseededCubeInBoundingCubeHasAttributeZero) {
+  const Grid g = testing::KuhnGrid(6);
+  plc::Plc plc;
+  testing::AddBox(&plc, {2, 2, 2}, {4, 4, 4}, 5);
+  const auto faces = testing::FacesOnConvexFacets(g.positions, g.tets,
+                                                  testing::ConvexFacetsOf(plc, CoordinateMap{}));
+  LabelInput in;
+  in.positions = g.positions;
+  in.tets = g.tets;
+  in.constrained_faces = faces;
+  auto l = LabelRegions(in);
+  ASSERT_TRUE(l.ok()) << l.status();
+  EXPECT_EQ(l->components.size(), 2u);
+  EXPECT_EQ(l->num_kept_tets, 8u * 6u);
+  for (size_t t = 0; t < g.tets.size(); ++t) {
+    const bool inside = Inside(Centroid(g, g.tets[t]), 2, 4);
+    EXPECT_EQ(l->Kept(static_cast<uint32_t>(t)), inside);
+    if (inside) {
+      EXPECT_EQ(l->components[l->tet_component[t]].attribute, 0);
+    }
+  }
+  EXPECT_EQ(l->faces.size(), 6u * 4u * 2u);
+  for (const auto& f : l->faces) {
+    EXPECT_EQ(f.marker, 5);
+    EXPECT_FALSE(l->Kept(f.tets[1]));
+  }
+}
+
+TEST(LabellingTest, SeedWarningsFirstSeedWins) {
+  Nested nb;
+  const std::vector<plc::RegionSeed> seeds = {
+      {{1.5, 1.5, 1.5}, 10, 0},      // 0: outer shell
+      {{100, 100, 100}, 11, 0},      // 1: outside the mesh
+      {{0.5, 0.5, 0.5}, 12, 0},      // 2: exterior (dropped)
+      {{6.5, 6.5, 6.5}, 13, 0},      // 3: outer shell again, other attribute: conflict
+      {{6.5, 1.5, 6.5}, 10, 0},      // 4: outer shell, same attribute: fine
+      {{4.5, 4.5, 4.5}, 14, 0},      // 5: in the hole
+  };
+  const std::vector<Vec3> holes = {{4.1, 4.2, 4.3}, {-5, 0, 0}};
+  auto l = LabelRegions(nb.Input(seeds, holes));
+  ASSERT_TRUE(l.ok()) << l.status();
+  std::vector<std::pair<LabelIssueKind, int64_t>> got;
+  for (const auto& i : l->issues) got.push_back({i.kind, i.ids[0]});
+  const std::vector<std::pair<LabelIssueKind, int64_t>> want = {
+      {LabelIssueKind::kHoleSeedOutsideMesh, 1}, {LabelIssueKind::kSeedOutsideMesh, 1},
+      {LabelIssueKind::kSeedConflict, 3},        {LabelIssueKind::kSeedDropped, 2},
+      {LabelIssueKind::kSeedDropped, 5}};
+  // Order: hole seeds, region seeds, then drops in component order.
+  ASSERT_EQ(got.size(), want.size());
+  for (const auto& w : want) EXPECT_NE(std::find(got.begin(), got.end(), w), got.end()) << int(w.first) << " " << w.second;
+  EXPECT_EQ(l->seed_tet[1], kNoTet);
+  EXPECT_EQ(l->hole_tet[1], kNoTet);
+  const Component& outer = l->components[l->tet_component[l->seed_tet[0]]];
+  EXPECT_EQ(outer.attribute, 10);
+  EXPECT_EQ(outer.seed, 0);
+  EXPECT_EQ(l->tet_component[l->seed_tet[3]], l->tet_component[l->seed_tet[0]]);
+  // The unseeded middle shell keeps attribute 0.
+  for (size_t t = 0; t < nb.grid.tets.size(); ++t) {
+    const Vec3 c = Centroid(nb.grid, nb.grid.tets[t]);
+    if (Inside(c, 2, 6) && !Inside(c, 3, 5)) {
+      const Component& m = l->components[l->tet_component[t]];
+      EXPECT_TRUE(m.kept);
+      EXPECT_EQ(m.seed, -1);
+      EXPECT_EQ(m.attribute, 0);
+    }
+  }
+}
+
+// A seed exactly on the middle box's face x = 2 touches tets of both shells;
+// the tet with the lexicographically smallest sorted vertex ids wins, whatever
+// the order of the tet list.
+TEST(LabellingTest, SeedOnFacetTieRuleIsOrderIndependent) {
+  Nested nb;
+  const std::vector<plc::RegionSeed> seeds = {{{2, 2.5, 3.25}, 7, 0}};
+  auto l = LabelRegions(nb.Input(seeds, {}));
+  ASSERT_TRUE(l.ok()) << l.status();
+  ASSERT_TRUE(HasIssue(*l, LabelIssueKind::kSeedOnFacet));
+  // Brute force: the containing tets and the smallest key.
+  std::array<uint32_t, 4> best{~0u, ~0u, ~0u, ~0u};
+  for (const auto& t : nb.grid.tets) {
+    const auto& P = nb.grid.positions;
+    const Vec3 q = seeds[0].point;
+    if (geom::Orient3d(q, P[t[1]], P[t[2]], P[t[3]]) < 0 || geom::Orient3d(P[t[0]], q, P[t[2]], P[t[3]]) < 0 ||
+        geom::Orient3d(P[t[0]], P[t[1]], q, P[t[3]]) < 0 || geom::Orient3d(P[t[0]], P[t[1]], P[t[2]], q) < 0) {
+      continue;
+    }
+    auto k = t;
+    std::sort(k.begin(), k.end());
+    best = std::min(best, k);
+  }
+  auto chosen = nb.grid.tets[l->seed_tet[0]];
+  std::sort(chosen.begin(), chosen.end());
+  EXPECT_EQ(chosen, best);
+  const bool in_middle = Inside(Centroid(nb.grid, nb.grid.tets[l->seed_tet[0]]), 2, 6);
+
+  // Reverse the tet list: the same tet (by vertex set) is chosen.
+  Nested rev;
+  std::reverse(rev.grid.tets.begin(), rev.grid.tets.end());
+  auto l2 = LabelRegions(rev.Input(seeds, {}));
+  ASSERT_TRUE(l2.ok());
+  auto chosen2 = rev.grid.tets[l2->seed_tet[0]];
+  std::sort(chosen2.begin(), chosen2.end());
+  EXPECT_EQ(chosen2, best);
+  for (size_t t = 0; t < rev.grid.tets.size(); ++t) {
+    const Vec3 c = Centroid(rev.grid, rev.grid.tets[t]);
+    const bool middle = Inside(c, 2, 6) && !Inside(c, 3, 5);
+    const bool outer = Inside(c, 1, 7) && !Inside(c, 2, 6);
+    if (middle || outer) {
+      EXPECT_EQ(l2->components[l2->tet_component[t]].attribute, (middle == in_middle) ? 7 : 0);
+    }
+  }
+}
+
+TEST(LabellingTest, DuplicateConstrainedFaceFirstMarkerWins) {
+  const Grid g = testing::KuhnGrid(2);
+  plc::Plc plc;
+  testing::AddBox(&plc, {0, 0, 0}, {2, 2, 2}, 4);
+  auto faces = testing::FacesOnConvexFacets(g.positions, g.tets,
+                                            testing::ConvexFacetsOf(plc, CoordinateMap{}));
+  ASSERT_EQ(faces.size(), 6u * 4u * 2u);  // the hull: every face constrained
+  ConstrainedFace dup = faces[3];
+  dup.marker = 99;
+  std::swap(dup.v[0], dup.v[2]);
+  faces.push_back(dup);
+  LabelInput in;
+  in.positions = g.positions;
+  in.tets = g.tets;
+  in.constrained_faces = faces;
+  auto l = LabelRegions(in);
+  ASSERT_TRUE(l.ok()) << l.status();
+  ASSERT_EQ(l->issues.size(), 1u);
+  EXPECT_EQ(l->issues[0].kind, LabelIssueKind::kDuplicateConstrainedFace);
+  EXPECT_EQ(l->issues[0].ids, (std::vector<int64_t>{48, 3}));
+  // The hull is all constrained: nothing touches ∂Ω, all 48 tets kept.
+  EXPECT_EQ(l->num_kept_tets, g.tets.size());
+  EXPECT_EQ(l->faces.size(), 48u);
+  for (const auto& f : l->faces) {
+    EXPECT_EQ(f.marker, 4);
+    EXPECT_EQ(f.tets[1], kNoTet);
+  }
+}
+
+TEST(LabellingTest, Errors) {
+  const Grid g = testing::KuhnGrid(2);
+  LabelInput in;
+  in.positions = g.positions;
+  in.tets = g.tets;
+  // No facets at all: everything touches ∂Ω and is dropped.
+  auto l = LabelRegions(in);
+  EXPECT_EQ(l.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(l.status().message().find("no tetrahedron is left"), std::string::npos);
+  // ... unless the box is kept.
+  in.keep_bounding_box = true;
+  EXPECT_TRUE(LabelRegions(in).ok());
+  // A constrained face that is not a face of the mesh (a diagonal of the grid
+  // cube not used by the Kuhn split).
+  const std::vector<ConstrainedFace> bad = {{{g.Id(1, 0, 0), g.Id(0, 1, 0), g.Id(0, 0, 1)}, 1, 0}};
+  in.constrained_faces = bad;
+  l = LabelRegions(in);
+  EXPECT_EQ(l.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(l.status().message().find("not a face"), std::string::npos) << l.status();
+  in.constrained_faces = {};
+  // A face in three tets.
+  std::vector<std::array<uint32_t, 4>> tets = g.tets;
+  tets.push_back(tets[0]);
+  in.tets = tets;
+  l = LabelRegions(in);
+  EXPECT_EQ(l.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(l.status().message().find("tets"), std::string::npos);
+  // A vertex id out of range.
+  tets = g.tets;
+  tets[5][2] = 1000;
+  in.tets = tets;
+  EXPECT_EQ(LabelRegions(in).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace svrc::refine
