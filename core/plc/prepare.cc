@@ -716,7 +716,7 @@ class Preparer {
         Error(ProblemKind::kOpenBoundary,
               Cat("open surface: ", boundary.size(), " boundary edges (on a single face), e.g. vertices ",
                   EdgeList(boundary), "; a surface input must be closed to enclose a volume"),
-              boundary);
+              boundary, FacetLine(fc_.segments[boundary[0]].facets[0]));
       }
       if (!nonmanifold.empty()) {
         Warning(ProblemKind::kNonManifoldEdge,
@@ -754,7 +754,7 @@ class Preparer {
             Cat("the facets enclose no volume: ", boundary.size(),
                 " boundary edges lie on a single facet side, e.g. vertices ", EdgeList(boundary),
                 boundary.empty() ? "" : Cat(" (facet ", uint64_t{fc_.segments[boundary[0]].facets[0]} + base_, ")")),
-            boundary);
+            boundary, boundary.empty() ? 0 : FacetLine(fc_.segments[boundary[0]].facets[0]));
     } else if (!peeled.empty()) {
       Warning(ProblemKind::kDanglingFacet,
               Cat("facets ", List(peeled, base_, vo_.max_listed),

@@ -59,6 +59,7 @@ TEST(Validate, BadOpenCube) {
   EXPECT_EQ(r.errors[0].ids.size(), 4u);  // the four edges of the missing top
   EXPECT_THAT(r.errors[0].message, HasSubstr("enclose no volume: 4 boundary edges"));
   EXPECT_THAT(r.errors[0].message, HasSubstr("5-6, 5-8, 6-7, 7-8"));
+  EXPECT_EQ(r.errors[0].line, 17u);  // facet 2 (1 2 6 5), the first owning edge 5-6
 }
 
 TEST(Validate, BadSelfintTwoCubes) {
@@ -105,6 +106,7 @@ TEST(Validate, SharkOpenHas304BoundaryEdges) {
   EXPECT_EQ(r.errors[0].kind, ProblemKind::kOpenBoundary);
   EXPECT_EQ(r.errors[0].ids.size(), 304u);
   EXPECT_THAT(r.errors[0].message, HasSubstr("open surface: 304 boundary edges"));
+  EXPECT_GT(r.errors[0].line, 5248u);  // a face line (after the 5246 vertex lines)
 }
 
 TEST(Validate, ThingiSelfIntersections) {
@@ -117,6 +119,7 @@ TEST(Validate, ThingiSelfIntersections) {
   EXPECT_EQ(pairs.size(), 6u);
   EXPECT_TRUE(pairs.count({3, 17}));
   EXPECT_THAT(r.errors[0].message, HasSubstr("facet 4 and facet 18"));
+  EXPECT_EQ(r.errors[0].line, 16u);  // "facet normal" line of the 3rd triangle (facet 3)
 }
 
 TEST(Validate, ValidCorpusInputsPass) {
