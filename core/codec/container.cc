@@ -2,6 +2,7 @@
 // length-prefixed sections around Draco-coded columns (draco_columns.h).
 #include "core/codec/container.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -224,6 +225,12 @@ absl::StatusOr<std::string> EncodeTetMesh(const mesh::TetMesh& mesh, const Encod
     return s;
   }
   if (mesh.regions.size() > kMaxElements) return absl::ResourceExhaustedError("container: too many regions");
+  for (const std::string* s : {&mesh.provenance.svrc_version, &mesh.provenance.parameters,
+                               &mesh.provenance.input_sha256}) {
+    if (s->size() > std::numeric_limits<uint32_t>::max()) {
+      return Invalid("provenance string longer than 4 GiB");
+    }
+  }
 
   EncodeReport rep;
   uint16_t flags = 0;
