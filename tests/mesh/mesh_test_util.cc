@@ -1,7 +1,12 @@
 #include "tests/mesh/mesh_test_util.h"
 
+#include <sys/wait.h>
+
 #include <algorithm>
+#include <cstdlib>
 #include <map>
+
+#include "absl/strings/str_cat.h"
 
 namespace svrc::mesh::testing {
 
@@ -169,6 +174,16 @@ void AssignAxisAlignedTriangles(const plc::Plc& plc, TetMesh* mesh) {
     m.triangles.push_back(key);
     m.triangle_marker.push_back(marker);
   }
+}
+
+bool HaveTool(const std::string& tool) {
+  return std::system(absl::StrCat("command -v ", tool, " >/dev/null 2>&1").c_str()) == 0;
+}
+
+int RunIn(const std::string& dir, const std::string& cmd, const std::string& log) {
+  const std::string full = absl::StrCat("cd '", dir, "' && ", cmd, " > '", log, "' 2>&1");
+  const int rc = std::system(full.c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
 }
 
 double TotalVolume(const TetMesh& mesh) {

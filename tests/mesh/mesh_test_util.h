@@ -31,6 +31,13 @@ void AssignBoxTriangles(const plc::Plc& box_plc, TetMesh* mesh);
 // each with that facet's marker (first facet wins).
 void AssignAxisAlignedTriangles(const plc::Plc& plc, TetMesh* mesh);
 
+// True when `tool` is on PATH.
+bool HaveTool(const std::string& tool);
+
+// Runs `cmd` with sh in `dir`, stdout and stderr to `dir/log`; returns the
+// exit status (128 + signal when killed).
+int RunIn(const std::string& dir, const std::string& cmd, const std::string& log);
+
 // Sum of the floating-point tet volumes.
 double TotalVolume(const TetMesh& mesh);
 

@@ -10,16 +10,14 @@
 #include "core/mesh/read_tetgen.h"
 #include "core/plc/readers.h"
 #include "gtest/gtest.h"
+#include "tests/mesh/mesh_test_util.h"
 #include "tests/test_support.h"
 
 namespace svrc::mesh {
 namespace {
 
 namespace fs = std::filesystem;
-
-bool HaveTool(const std::string& tool) {
-  return std::system(absl::StrCat("command -v ", tool, " >/dev/null 2>&1").c_str()) == 0;
-}
+using testing::HaveTool;
 
 // Runs `tetgen -<switches>` on a copy of the corpus file in a fresh folder and
 // returns the path of the .1.node it wrote ("" after a failed expectation).
@@ -32,10 +30,12 @@ std::string RunTetgen(const std::string& corpus_file, const std::string& switche
   const fs::path dir = svrc::testing::MakeTempDir("tetgen");
   const fs::path copy = dir / src.filename();
   fs::copy_file(src, copy);
-  const std::string cmd = absl::StrCat("cd '", dir.string(), "' && stdbuf -o0 tetgen -", switches,
-                                       " '", copy.filename().string(), "' > tetgen.log 2>&1");
-  const int rc = std::system(cmd.c_str());
-  EXPECT_EQ(rc, 0) << cmd << "\n" << svrc::testing::ReadFileOrFail((dir / "tetgen.log").string());
+  const int rc = testing::RunIn(dir.string(),
+                                absl::StrCat("stdbuf -o0 tetgen -", switches, " '",
+                                             copy.filename().string(), "'"),
+                                "tetgen.log");
+  EXPECT_EQ(rc, 0) << "tetgen -" << switches << "\n"
+                   << svrc::testing::ReadFileOrFail((dir / "tetgen.log").string());
   fs::path node = copy;
   node.replace_extension(".1.node");
   EXPECT_TRUE(fs::exists(node)) << node;

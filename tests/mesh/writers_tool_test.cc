@@ -20,19 +20,11 @@ namespace svrc::mesh {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::HaveTool;
+using testing::RunIn;
 
 // Debian's interpreter: python3-vtk9 is installed for it, not for a pyenv one.
 constexpr char kPython[] = "/usr/bin/python3";
-
-bool HaveTool(const std::string& tool) {
-  return std::system(absl::StrCat("command -v ", tool, " >/dev/null 2>&1").c_str()) == 0;
-}
-
-int RunIn(const std::string& dir, const std::string& cmd, const std::string& log) {
-  const std::string full = absl::StrCat("cd '", dir, "' && ", cmd, " > '", log, "' 2>&1");
-  const int rc = std::system(full.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
-}
 
 // Markers 0 and -4 (remapped to positive physical tags in .msh), two regions,
 // coordinates that need 17 digits.
