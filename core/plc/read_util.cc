@@ -57,7 +57,7 @@ bool LineReader::NextLine() {
         bytes_[end + 1] == '\n') {
       next_ = end + 2;
     } else {
-      next_ = end + 1;
+      next_ = end < bytes_.size() ? end + 1 : end;  // never past the end
     }
     ++line_;
     tokens_.clear();

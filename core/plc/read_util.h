@@ -75,7 +75,9 @@ class LineReader {
   std::string_view raw_line() const { return raw_; }
   size_t line() const { return line_; }
   bool at_end() const { return next_ >= bytes_.size(); }
-  size_t bytes_left() const { return bytes_.size() - next_; }
+  // After a last line without a line ending next_ is size + 1: clamp, or the
+  // count caps (CappedReserve) wrap to SIZE_MAX (fuzz: plc_poly regression).
+  size_t bytes_left() const { return next_ < bytes_.size() ? bytes_.size() - next_ : 0; }
 
   // Next token, continuing on the following lines if this one is used up.
   // Returns an error naming `what` at end of input.

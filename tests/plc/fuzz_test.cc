@@ -109,13 +109,18 @@ TEST(ReaderFuzz, MutatedCorpusFilesNeverCrash) {
 
 TEST(ReaderFuzz, HugeCountsDoNotAllocate) {
   // Counts far beyond the bytes present must fail fast, not reserve memory.
+  // The last two end without a line ending (regression: the bytes left
+  // after the last line wrapped around and the reservation cap vanished).
   const std::string cases[] = {
       "2000000000 3 0 0\n1 0 0 0\n",
       "OFF\n2000000000 2000000000 0\n0 0 0\n",
       "MeshVersionFormatted 1\nDimension 3\nVertices\n2000000000\n0 0 0 0\n",
+      "2000000000 3 0 0",
+      "OFF\n2000000000 2000000000 0",
   };
-  const InputFormat formats[] = {InputFormat::kPoly, InputFormat::kOff, InputFormat::kMedit};
-  for (int i = 0; i < 3; ++i) {
+  const InputFormat formats[] = {InputFormat::kPoly, InputFormat::kOff, InputFormat::kMedit,
+                                 InputFormat::kPoly, InputFormat::kOff};
+  for (int i = 0; i < 5; ++i) {
     const auto t0 = Clock::now();
     absl::StatusOr<Plc> plc = ReadPlcBytes(cases[i], formats[i], "huge");
     EXPECT_EQ(plc.status().code(), absl::StatusCode::kInvalidArgument);
