@@ -65,6 +65,7 @@ TEST_F(CliTest, LocalAndRemoteOutputsAreByteIdentical) {
   }
   EXPECT_TRUE(fs::exists(dir + "/local.node/out.ele"));
   EXPECT_TRUE(fs::exists(dir + "/local.node/out.face"));
+  fs::remove_all(dir);
 }
 
 TEST_F(CliTest, SubmitPrintsTheJobIdThenGetListAndHealthWork) {
@@ -156,6 +157,7 @@ TEST_F(CliTest, ExitStatuses) {
   EXPECT_EQ(RunSvrc({"cancel", id, "--server", server_->address()}).exit_code, 0);
   EXPECT_EQ(RunSvrc({"watch", id, "--server", server_->address()}).exit_code, 6);
   EXPECT_EQ(RunSvrc({"get", id, "--server", server_->address(), "-o", dir + "/c.vtu"}).exit_code, 6);
+  fs::remove_all(dir);
 }
 
 TEST(CliVersionTest, PrintsTheVersion) {

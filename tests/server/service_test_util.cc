@@ -94,6 +94,9 @@ ServerProcess::~ServerProcess() {
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
+  std::error_code ec;
+  std::filesystem::remove_all(data_dir_, ec);
+  std::filesystem::remove(log_path_, ec);
 }
 
 int ServerProcess::Terminate(double timeout_s) {
