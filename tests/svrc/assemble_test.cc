@@ -314,6 +314,44 @@ TEST(AssembleCorpusTest, ConvexInputsConform) {
   }
 }
 
+// The refiner's layout: input vertices, then the 8 corners of a bounding cube
+// Ω (side 3× the input's, as docs/svrc-design.md §3), Delaunay of all of them.
+// The exterior touches ∂Ω and is dropped with Ω's corners; the rest conforms.
+TEST(AssembleCorpusTest, ConvexInputInBoundingCube) {
+  for (const char* rel : {"a_convex/cube.poly", "b_internal/box_internal_facet.poly"}) {
+    SCOPED_TRACE(rel);
+    auto plc = plc::ReadPlcFile(svrc::testing::CorpusPath(rel));
+    ASSERT_TRUE(plc.ok()) << plc.status();
+    std::vector<Vec3> pts = plc->vertices;
+    for (int c = 0; c < 8; ++c) pts.push_back({(c & 1) ? 2.0 : -1.0, (c & 2) ? 2.0 : -1.0, (c & 4) ? 2.0 : -1.0});
+    auto del = delaunay::TetrahedralizePointSet(pts);
+    ASSERT_TRUE(del.ok()) << del.status();
+    const CoordinateMap id;
+    const auto faces = testing::FacesOnConvexFacets(pts, del->tets, testing::ConvexFacetsOf(*plc, id));
+    std::vector<uint32_t> iv(del->representative.begin(), del->representative.begin() + plc->vertices.size());
+    auto r = BuildOutputMesh(*plc, pts, del->tets, iv, faces, id, false);
+    ASSERT_TRUE(r.ok()) << r.status();
+    EXPECT_TRUE(r->issues.empty());
+    EXPECT_EQ(r->report.num_dropped_vertices, 8u);
+    EXPECT_EQ(r->mesh.positions.size(), plc->vertices.size());
+    EXPECT_GT(r->report.num_dropped_tets, 0u);
+    const mesh::ConformityReport rep = mesh::CheckConformity(*plc, r->mesh);
+    EXPECT_TRUE(rep.ok()) << rep.Summary();
+    EXPECT_NEAR(MeshVolume(r->mesh), 1.0, 1e-12);
+    // With keep_bounding_box: the whole Ω, volume 27, one unseeded region more.
+    auto k = BuildOutputMesh(*plc, pts, del->tets, iv, faces, id, true);
+    ASSERT_TRUE(k.ok()) << k.status();
+    EXPECT_EQ(k->mesh.tets.size(), del->tets.size());
+    EXPECT_EQ(k->mesh.regions.size(), r->mesh.regions.size() + 1);
+    EXPECT_EQ(k->mesh.regions.back().attribute, 0);
+    EXPECT_NEAR(MeshVolume(k->mesh), 27.0, 1e-12);
+    mesh::ConformityOptions opt;
+    opt.keep_bounding_box = true;
+    const mesh::ConformityReport krep = mesh::CheckConformity(*plc, k->mesh, opt);
+    EXPECT_TRUE(krep.ok()) << krep.Summary();
+  }
+}
+
 // box_internal_facet.poly: the unit cube split at z = 0.5 (marker 7), regions
 // 1 (below) and 2 (above). TetGen -pA writes 12 tets and 22 faces, the 2
 // internal ones with marker 7 and normals pointing down (into region 1).
