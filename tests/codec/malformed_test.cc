@@ -272,6 +272,18 @@ TEST(MalformedTest, CountsAreBoundedBeforeAllocation) {
   SectionPayload(p, "CNTS") = Counts(nv, 8, nt, 0, 2);
   ExpectInvalid(Join(p), "no triangles but bytes");
 
+  // 100M tets behind a Draco header patched to agree: only the memory limit
+  // stands between this and Draco sizing its buffers by the count.
+  p = good;
+  SectionPayload(p, "CNTS") = Counts(nv, 8, 100000000, ntri, 2);
+  std::string& tets = SectionPayload(p, "TETS");
+  const uint32_t big = 100000000;
+  for (int i = 0; i < 4; ++i) tets[11 + i] = static_cast<char>((big >> (8 * i)) & 0xFF);
+  const absl::StatusOr<mesh::TetMesh> refused = DecodeTetMesh(Join(p));
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.status().message().find("over the decoder's limit"), std::string::npos)
+      << refused.status();
+
   // The caller's own limit.
   DecodeOptions tight;
   tight.max_mesh_bytes = 100;
