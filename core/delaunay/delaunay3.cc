@@ -60,8 +60,7 @@ void Delaunay3::Reserve(size_t num_vertices) {
   global_ids_.reserve(num_vertices);
   vertex_tet_.reserve(num_vertices);
   const size_t tets = num_vertices * 7 + 64;
-  tet_v_.reserve(4 * tets);
-  tet_n_.reserve(4 * tets);
+  tets_.reserve(8 * tets);
   tet_gen_.reserve(tets);
   tet_mark_.reserve(tets);
 }
@@ -72,7 +71,7 @@ void Delaunay3::Reserve(size_t num_vertices) {
 inline uint32_t Delaunay3::NewTet() {
   if (free_head_ == kFreeSlot) GrowTets();
   const uint32_t t = free_head_;
-  free_head_ = tet_n_[4 * t];
+  free_head_ = tets_[8 * t + 4];
   ++num_live_tets_;
   return t;
 }
@@ -83,20 +82,19 @@ void Delaunay3::GrowTets() {
   const uint32_t old_cap = TetCapacity();
   const uint32_t add = std::max<uint32_t>(64, old_cap / 4);
   const size_t cap = size_t{old_cap} + add;
-  tet_v_.resize(4 * cap, kFreeSlot);
-  tet_n_.resize(4 * cap, 0);
+  tets_.resize(8 * cap, kFreeSlot);
   tet_gen_.resize(cap, 0);
   tet_mark_.resize(cap, 0);
   for (uint32_t t = static_cast<uint32_t>(cap); t-- > old_cap;) {
-    tet_n_[4 * t] = free_head_;
+    tets_[8 * t + 4] = free_head_;
     free_head_ = t;
   }
 }
 
 inline void Delaunay3::FreeTet(uint32_t t) {
-  if (tet_v_[4 * t + 3] == kInf) --num_ghost_tets_;
-  tet_v_[4 * t] = kFreeSlot;
-  tet_n_[4 * t] = free_head_;
+  if (tets_[8 * t + 3] == kInf) --num_ghost_tets_;
+  tets_[8 * t] = kFreeSlot;
+  tets_[8 * t + 4] = free_head_;
   free_head_ = t;
   ++tet_gen_[t];
   --num_live_tets_;
@@ -121,7 +119,7 @@ uint32_t Delaunay3::FreshStamps(uint32_t n) const {
 // symbolic perturbation (an exactly cospherical / coplanar configuration).
 [[gnu::always_inline]] inline bool Delaunay3::ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid,
                                    uint32_t* sos_used) const {
-  const uint32_t* v = &tet_v_[4 * t];
+  const uint32_t* v = &tets_[8 * t];
   if (v[3] != kInf) {
     const int s = geom::InSphere(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]], p);
     if (s != 0) return s > 0;
@@ -130,7 +128,7 @@ uint32_t Delaunay3::FreshStamps(uint32_t n) const {
 }
 
 bool Delaunay3::ConflictSlow(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const {
-  const uint32_t* v = &tet_v_[4 * t];
+  const uint32_t* v = &tets_[8 * t];
   if (v[3] != kInf) {
     // The exact in-sphere value is 0 (ConflictRaw ran it).
     *sos_used = 1;
@@ -145,7 +143,7 @@ bool Delaunay3::ConflictSlow(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* 
   // perturbation the opposite vertex's term has coefficient Orient3d(a,b,c,p) = 0.
   const int o = geom::Orient3d(points_[v[0]], points_[v[1]], points_[v[2]], p);
   if (o != 0) return o > 0;
-  return ConflictRaw(tet_n_[4 * t + 3] >> 2, p, gid, sos_used);
+  return ConflictRaw(tets_[8 * t + 4 + 3] >> 2, p, gid, sos_used);
 }
 
 bool Delaunay3::InConflict(TetId t, const Vec3& p, uint32_t global_id) const {
@@ -159,11 +157,11 @@ bool Delaunay3::InConflict(TetId t, const Vec3& p, uint32_t global_id) const {
 // cycle in practice and is still deterministic. Returns a finite tet whose
 // closure contains p, or the ghost tet across the hull face p is beyond.
 uint32_t Delaunay3::WalkRaw(const Vec3& p, uint32_t t, uint32_t* steps) const {
-  if (tet_v_[4 * t + 3] == kInf) t = tet_n_[4 * t + 3] >> 2;
+  if (tets_[8 * t + 3] == kInf) t = tets_[8 * t + 4 + 3] >> 2;
   uint32_t rng = 0x2545F491u;
   uint32_t from = 4;  // face we entered through (skip it)
   for (;;) {
-    const uint32_t* v = &tet_v_[4 * t];
+    const uint32_t* v = &tets_[8 * t];
     rng ^= rng << 13;
     rng ^= rng >> 17;
     rng ^= rng << 5;
@@ -185,11 +183,11 @@ uint32_t Delaunay3::WalkRaw(const Vec3& p, uint32_t t, uint32_t* steps) const {
         default: o = geom::Orient3d(a, b, c, p); break;
       }
       if (o < 0) {
-        const uint32_t n = tet_n_[4 * t + f];
+        const uint32_t n = tets_[8 * t + 4 + f];
         t = n >> 2;
         from = n & 3;
         ++*steps;
-        if (tet_v_[4 * t + 3] == kInf) return t;
+        if (tets_[8 * t + 3] == kInf) return t;
         moved = true;
         break;
       }
@@ -228,13 +226,13 @@ Delaunay3::InsertResult Delaunay3::Insert(const Vec3& p, uint32_t global_id, Tet
     stats_.walk_steps += steps;
     // A finite tet whose closure holds p conflicts with p (p is strictly
     // inside its circumsphere) unless p is one of its vertices.
-    if (tet_v_[4 * start + 3] != kInf) {
+    if (tets_[8 * start + 3] != kInf) {
       for (int i = 0; i < 4; ++i) {
-        if (points_[tet_v_[4 * start + i]] == p) {
+        if (points_[tets_[8 * start + i]] == p) {
           ++stats_.duplicates;
           InsertResult r;
           r.outcome = InsertOutcome::kDuplicate;
-          r.vertex = VertexId(tet_v_[4 * start + i]);
+          r.vertex = VertexId(tets_[8 * start + i]);
           return r;
         }
       }
@@ -271,7 +269,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
     stack_.pop_back();
     destroyed_.push_back(TetId(t));
     for (uint32_t f = 0; f < 4; ++f) {
-      const uint32_t n = tet_n_[4 * t + f];
+      const uint32_t n = tets_[8 * t + 4 + f];
       const uint32_t u = n >> 2;
       const uint32_t m = tet_mark_[u];
       if (m == in_cavity) continue;
@@ -293,7 +291,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
     for (TetId dt : destroyed_) {
       const uint32_t t = dt.value();
       for (int i = 0; i < 4; ++i) {
-        const uint32_t w = tet_v_[4 * t + i];
+        const uint32_t w = tets_[8 * t + i];
         if (w != kInf && w != v && points_[w] == p) {
           ++stats_.duplicates;
           // Nothing was modified; clear the cavity marks.
@@ -316,9 +314,9 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
   for (size_t k = 0; k < nb; ++k) {
     const uint32_t bf = boundary_[k];
     const uint32_t t = bf >> 2;
-    std::copy_n(&tet_v_[4 * t], 4, &new_v_[4 * k]);
+    std::copy_n(&tets_[8 * t], 4, &new_v_[4 * k]);
     new_v_[4 * k + (bf & 3)] = v;
-    new_outer_[k] = tet_n_[bf];
+    new_outer_[k] = tets_[NRef(bf)];
   }
   for (TetId dt : destroyed_) FreeTet(dt.value());
 
@@ -332,13 +330,13 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
   for (size_t k = 0; k < nb; ++k) {
     const uint32_t t = NewTet();
     created_[k] = TetId(t);
-    uint32_t* tv = &tet_v_[4 * t];
+    uint32_t* tv = &tets_[8 * t];
     std::copy_n(&new_v_[4 * k], 4, tv);
     if (tv[3] == kInf) ++num_ghost_tets_;
     const uint32_t f = boundary_[k] & 3;
     const uint32_t o = new_outer_[k];
-    tet_n_[4 * t + f] = o;
-    tet_n_[o] = 4 * t + f;
+    tets_[8 * t + 4 + f] = o;
+    tets_[NRef(o)] = 4 * t + f;
     tet_mark_[t] = 0;
     for (uint32_t i = 0; i < 4; ++i) {
       if (i == f) continue;
@@ -353,8 +351,8 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
           break;
         }
         if (e.key == key) {
-          tet_n_[4 * t + i] = e.val;
-          tet_n_[e.val] = 4 * t + i;
+          tets_[8 * t + 4 + i] = e.val;
+          tets_[NRef(e.val)] = 4 * t + i;
           break;
         }
         h = (h + 1) & mask;
@@ -373,7 +371,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
       vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
     }
     for (TetId ct : created_) {
-      const uint32_t* tv = &tet_v_[4 * ct.value()];
+      const uint32_t* tv = &tets_[8 * ct.value()];
       for (int i = 0; i < 4; ++i) {
         const uint32_t w = tv[i];
         if (w == kInf || w == v || vertex_mark_[w] == vertex_stamp_) continue;
@@ -405,7 +403,7 @@ void Delaunay3::LinkAroundApex(uint32_t apex) {
   const uint32_t mask = EdgeTableFor(created_.size());
   for (TetId ct : created_) {
     const uint32_t t = ct.value();
-    const uint32_t* tv = &tet_v_[4 * t];
+    const uint32_t* tv = &tets_[8 * t];
     int a = 0;
     while (tv[a] != apex) ++a;
     for (int i = 0; i < 4; ++i) {
@@ -419,8 +417,8 @@ void Delaunay3::LinkAroundApex(uint32_t apex) {
           break;
         }
         if (e.key == key) {
-          tet_n_[4 * t + i] = e.val;
-          tet_n_[e.val] = 4 * t + i;
+          tets_[8 * t + 4 + i] = e.val;
+          tets_[NRef(e.val)] = 4 * t + i;
           break;
         }
         h = (h + 1) & mask;
@@ -510,7 +508,7 @@ void Delaunay3::BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
   if (geom::Orient3d(points_[a], points_[b], points_[c], points_[d]) < 0) std::swap(a, b);
   const uint32_t t0 = NewTet();
   const uint32_t tv[4] = {a, b, c, d};
-  for (int i = 0; i < 4; ++i) tet_v_[4 * t0 + i] = tv[i];
+  for (int i = 0; i < 4; ++i) tets_[8 * t0 + i] = tv[i];
   tet_mark_[t0] = 0;
   created_.clear();
   for (int f = 0; f < 4; ++f) {
@@ -521,11 +519,11 @@ void Delaunay3::BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
     if (f != 3) std::swap(g[f], g[3]);
     else std::swap(g[0], g[1]);
     const uint32_t t = NewTet();
-    for (int i = 0; i < 4; ++i) tet_v_[4 * t + i] = g[i];
+    for (int i = 0; i < 4; ++i) tets_[8 * t + i] = g[i];
     ++num_ghost_tets_;
     tet_mark_[t] = 0;
-    tet_n_[4 * t + 3] = 4 * t0 + f;
-    tet_n_[4 * t0 + f] = 4 * t + 3;
+    tets_[8 * t + 4 + 3] = 4 * t0 + f;
+    tets_[8 * t0 + 4 + f] = 4 * t + 3;
     created_.push_back(TetId(t));
   }
   LinkAroundApex(kInf);
@@ -540,7 +538,7 @@ std::vector<TetId> Delaunay3::FiniteTets() const {
   std::vector<TetId> out;
   out.reserve(NumFiniteTets());
   for (uint32_t t = 0; t < TetCapacity(); ++t) {
-    if (tet_v_[4 * t] != kFreeSlot && tet_v_[4 * t + 3] != kInf) out.push_back(TetId(t));
+    if (tets_[8 * t] != kFreeSlot && tets_[8 * t + 3] != kInf) out.push_back(TetId(t));
   }
   return out;
 }
@@ -555,8 +553,8 @@ void Delaunay3::StarRaw(uint32_t v, std::vector<uint32_t>* out) const {
   for (size_t k = 0; k < out->size(); ++k) {
     const uint32_t t = (*out)[k];
     for (int f = 0; f < 4; ++f) {
-      if (tet_v_[4 * t + f] == v) continue;  // the face opposite v does not contain v
-      const uint32_t u = tet_n_[4 * t + f] >> 2;
+      if (tets_[8 * t + f] == v) continue;  // the face opposite v does not contain v
+      const uint32_t u = tets_[8 * t + 4 + f] >> 2;
       if (tet_mark_[u] != stamp) {
         tet_mark_[u] = stamp;
         out->push_back(u);
@@ -581,7 +579,7 @@ void Delaunay3::Neighbors(VertexId v, std::vector<VertexId>* out) const {
   if (vertex_mark_.size() < points_.size()) vertex_mark_.resize(points_.size() + 16, 0);
   for (uint32_t t : star) {
     for (int i = 0; i < 4; ++i) {
-      const uint32_t w = tet_v_[4 * t + i];
+      const uint32_t w = tets_[8 * t + i];
       if (w == kInf || w == v.value() || vertex_mark_[w] == vertex_stamp_) continue;
       vertex_mark_[w] = vertex_stamp_;
       out->push_back(VertexId(w));
@@ -593,7 +591,7 @@ bool Delaunay3::IsHullVertex(VertexId v) const {
   std::vector<uint32_t> star;
   StarRaw(v.value(), &star);
   for (uint32_t t : star) {
-    if (tet_v_[4 * t + 3] == kInf) return true;
+    if (tets_[8 * t + 3] == kInf) return true;
   }
   return false;
 }
@@ -603,7 +601,7 @@ void Delaunay3::VoronoiCorners(VertexId v, std::vector<Vec3>* out) const {
   StarRaw(v.value(), &star);
   out->clear();
   for (uint32_t t : star) {
-    if (tet_v_[4 * t + 3] != kInf) out->push_back(Circumcenter(TetId(t)));
+    if (tets_[8 * t + 3] != kInf) out->push_back(Circumcenter(TetId(t)));
   }
 }
 
@@ -614,7 +612,7 @@ double Delaunay3::OutRadius(VertexId v, Vec3* farthest_corner) const {
   double best = -1;
   Vec3 corner;
   for (uint32_t t : star) {
-    if (tet_v_[4 * t + 3] == kInf) {
+    if (tets_[8 * t + 3] == kInf) {
       if (farthest_corner) *farthest_corner = Vec3(HUGE_VAL, HUGE_VAL, HUGE_VAL);
       return std::numeric_limits<double>::infinity();
     }
@@ -653,7 +651,7 @@ VertexId Delaunay3::NearestVertex(const Vec3& p, TetId hint) const {
     return true;
   };
   for (int i = 0; i < 4; ++i) {
-    if (tet_v_[4 * t + i] != kInf) consider(tet_v_[4 * t + i]);
+    if (tets_[8 * t + i] != kInf) consider(tets_[8 * t + i]);
   }
   // Greedy descent: in a Delaunay graph, a vertex that is not nearest to p
   // has a neighbour strictly nearer (the Delaunay graph contains the nearest
@@ -668,7 +666,7 @@ VertexId Delaunay3::NearestVertex(const Vec3& p, TetId hint) const {
 }
 
 Vec3 Delaunay3::Circumcenter(TetId t) const {
-  const uint32_t* v = &tet_v_[4 * t.value()];
+  const uint32_t* v = &tets_[8 * t.value()];
   const Vec3 a = points_[v[0]];
   const Vec3 b = points_[v[1]] - a, c = points_[v[2]] - a, d = points_[v[3]] - a;
   // Relative to a: x = (|b|²(c×d) + |c|²(d×b) + |d|²(b×c)) / (2 b·(c×d)).
@@ -679,7 +677,7 @@ Vec3 Delaunay3::Circumcenter(TetId t) const {
 }
 
 double Delaunay3::Circumradius(TetId t) const {
-  return geom::Dist(Circumcenter(t), points_[tet_v_[4 * t.value()]]);
+  return geom::Dist(Circumcenter(t), points_[tets_[8 * t.value()]]);
 }
 
 // ---------------------------------------------------------------------------
@@ -689,7 +687,7 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
   const uint32_t cap = TetCapacity();
   uint32_t live = 0, ghosts = 0;
   for (uint32_t t = 0; t < cap; ++t) {
-    const uint32_t* v = &tet_v_[4 * t];
+    const uint32_t* v = &tets_[8 * t];
     if (v[0] == kFreeSlot) continue;
     ++live;
     for (int i = 0; i < 4; ++i) {
@@ -709,12 +707,12 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
                                               ") is not positively oriented"));
     }
     for (int f = 0; f < 4; ++f) {
-      const uint32_t n = tet_n_[4 * t + f];
+      const uint32_t n = tets_[8 * t + 4 + f];
       const uint32_t u = n >> 2, g = n & 3;
-      if (u >= cap || tet_v_[4 * u] == kFreeSlot) {
+      if (u >= cap || tets_[8 * u] == kFreeSlot) {
         return absl::InternalError(absl::StrCat("tet ", t, " face ", f, ": neighbour ", u, " is not alive"));
       }
-      if (tet_n_[n] != 4 * t + f) {
+      if (tets_[NRef(n)] != 4 * t + f) {
         return absl::InternalError(absl::StrCat("tet ", t, " face ", f, ": neighbour ", u, " face ", g,
                                                 " does not point back"));
       }
@@ -723,7 +721,7 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
       const int* fa = kFaceVertices[f];
       const int* fb = kFaceVertices[g];
       uint32_t A[3] = {v[fa[0]], v[fa[1]], v[fa[2]]};
-      uint32_t B[3] = {tet_v_[4 * u + fb[0]], tet_v_[4 * u + fb[1]], tet_v_[4 * u + fb[2]]};
+      uint32_t B[3] = {tets_[8 * u + fb[0]], tets_[8 * u + fb[1]], tets_[8 * u + fb[2]]};
       // Orientation of a face listed by kFaceVertices[f] flips with the
       // parity of f (faces 0 and 2 are listed negatively w.r.t. the outward
       // normal, 1 and 3 positively), so normalise to outward order.
@@ -740,15 +738,15 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
       }
       if (ghost && u == t) return absl::InternalError("self-neighbour");
     }
-    if (tet_gen_.size() != cap || tet_n_.size() != 4 * size_t{cap}) return absl::InternalError("array sizes");
+    if (tet_gen_.size() != cap || tets_.size() != 8 * size_t{cap}) return absl::InternalError("array sizes");
   }
   if (live != num_live_tets_ || ghosts != num_ghost_tets_) {
     return absl::InternalError(absl::StrCat("tet counts: found ", live, " live / ", ghosts,
                                             " ghost, recorded ", num_live_tets_, " / ", num_ghost_tets_));
   }
   uint32_t free_count = 0;
-  for (uint32_t t = free_head_; t != kFreeSlot; t = tet_n_[4 * t]) {
-    if (t >= cap || tet_v_[4 * t] != kFreeSlot || ++free_count > cap) {
+  for (uint32_t t = free_head_; t != kFreeSlot; t = tets_[8 * t + 4]) {
+    if (t >= cap || tets_[8 * t] != kFreeSlot || ++free_count > cap) {
       return absl::InternalError("free list corrupt");
     }
   }
@@ -757,10 +755,10 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
     for (uint32_t w = 0; w < points_.size(); ++w) {
       const uint32_t t = vertex_tet_[w];
       if (t == kFreeSlot) continue;  // a rejected duplicate never gets here; pending only before 3D
-      if (t >= cap || tet_v_[4 * t] == kFreeSlot) {
+      if (t >= cap || tets_[8 * t] == kFreeSlot) {
         return absl::InternalError(absl::StrCat("vertex ", w, ": incident tet ", t, " not alive"));
       }
-      const uint32_t* v = &tet_v_[4 * t];
+      const uint32_t* v = &tets_[8 * t];
       if (v[0] != w && v[1] != w && v[2] != w && v[3] != w) {
         return absl::InternalError(absl::StrCat("vertex ", w, ": tet ", t, " does not contain it"));
       }
@@ -774,11 +772,11 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
   // Convex hull: for ghost (a,b,c,∞), the finite vertex d of a neighbouring
   // ghost must not be strictly beyond abc.
   for (uint32_t t = 0; t < cap; ++t) {
-    const uint32_t* v = &tet_v_[4 * t];
+    const uint32_t* v = &tets_[8 * t];
     if (v[0] == kFreeSlot || v[3] != kInf) continue;
     for (int f = 0; f < 3; ++f) {
-      const uint32_t n = tet_n_[4 * t + f];
-      const uint32_t d = tet_v_[4 * (n >> 2) + (n & 3)];
+      const uint32_t n = tets_[8 * t + 4 + f];
+      const uint32_t d = tets_[8 * (n >> 2) + (n & 3)];
       if (d == kInf) return absl::InternalError("ghost neighbour opposite ∞");
       const int o = geom::Orient3d(points_[v[0]], points_[v[1]], points_[v[2]], points_[d]);
       if (o > 0) {
@@ -796,13 +794,13 @@ absl::Status Delaunay3::Validate(bool check_empty_sphere) const {
   }
   if (check_empty_sphere) {
     for (uint32_t t = 0; t < cap; ++t) {
-      const uint32_t* v = &tet_v_[4 * t];
+      const uint32_t* v = &tets_[8 * t];
       if (v[0] == kFreeSlot || v[3] == kInf) continue;
       for (int f = 0; f < 4; ++f) {
-        const uint32_t n = tet_n_[4 * t + f];
+        const uint32_t n = tets_[8 * t + 4 + f];
         const uint32_t u = n >> 2;
-        if (tet_v_[4 * u + 3] == kInf) continue;
-        const uint32_t d = tet_v_[4 * u + (n & 3)];
+        if (tets_[8 * u + 3] == kInf) continue;
+        const uint32_t d = tets_[8 * u + (n & 3)];
         uint32_t sos = 0;
         if (ConflictRaw(t, points_[d], global_ids_[d], &sos)) {
           return absl::InternalError(absl::StrCat("face ", f, " of tet ", t, " (", v[0], ",", v[1], ",",

@@ -3,9 +3,9 @@
 // Voronoi queries SVRC needs on M_Ω (thesis §3.2, Definition 12, Lemma 3).
 //
 // Storage follows Geogram/HXT: flat struct-of-arrays with 32-bit indices.
-//   tet_v_[4t+i]  vertex i of tet t; kInfinite for the ghost vertex, which is
+//   tets_[8t+i]    vertex i of tet t (i < 4); kInfinite for the ghost vertex, which is
 //                 always at position 3 of a ghost tet.
-//   tet_n_[4t+f]  the neighbour across face f (the face opposite vertex f),
+//   tets_[8t+4+f]  the neighbour across face f (the face opposite vertex f),
 //                 encoded 4t'+f' where f' is the same face seen from t'.
 // Every live tet is positively oriented: Orient3d(v0,v1,v2,v3) > 0. A ghost
 // tet (a,b,c,∞) has its finite face abc on the hull, oriented so that the
@@ -135,13 +135,13 @@ class Delaunay3 {
   // One live tet incident to v (kNoneTet while v is pending).
   TetId VertexTet(VertexId v) const { return TetId(vertex_tet_[v.value()]); }
 
-  bool IsAlive(TetId t) const { return tet_v_[4 * t.value()] != kFreeSlot; }
-  bool IsGhost(TetId t) const { return tet_v_[4 * t.value() + 3] == kInfiniteVertex.value(); }
+  bool IsAlive(TetId t) const { return tets_[8 * t.value()] != kFreeSlot; }
+  bool IsGhost(TetId t) const { return tets_[8 * t.value() + 3] == kInfiniteVertex.value(); }
   uint32_t Generation(TetId t) const { return tet_gen_[t.value()]; }
-  VertexId TetVertex(TetId t, int i) const { return VertexId(tet_v_[4 * t.value() + i]); }
+  VertexId TetVertex(TetId t, int i) const { return VertexId(tets_[8 * t.value() + i]); }
   // The tet across face f (opposite vertex f) and that face's index there.
-  TetId Neighbor(TetId t, int f) const { return TetId(tet_n_[4 * t.value() + f] >> 2); }
-  int NeighborFace(TetId t, int f) const { return static_cast<int>(tet_n_[4 * t.value() + f] & 3); }
+  TetId Neighbor(TetId t, int f) const { return TetId(tets_[8 * t.value() + 4 + f] >> 2); }
+  int NeighborFace(TetId t, int f) const { return static_cast<int>(tets_[8 * t.value() + 4 + f] & 3); }
 
   // All live finite tets, in slot order.
   std::vector<TetId> FiniteTets() const;
@@ -217,8 +217,9 @@ class Delaunay3 {
   std::vector<uint32_t> global_ids_;
   std::vector<uint32_t> vertex_tet_;
   // Tets.
-  std::vector<uint32_t> tet_v_;
-  std::vector<uint32_t> tet_n_;
+  // Index in tets_ of the neighbour slot named by the encoding 4t+f.
+  static constexpr uint32_t NRef(uint32_t n) { return 8 * (n >> 2) + 4 + (n & 3); }
+  std::vector<uint32_t> tets_;  // per tet: 4 vertices then 4 neighbours (one cache line per 2 tets)
   std::vector<uint32_t> tet_gen_;
   mutable std::vector<uint32_t> tet_mark_;  // scratch stamps for searches
   mutable uint32_t mark_stamp_ = 0;
