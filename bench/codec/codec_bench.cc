@@ -67,13 +67,9 @@ size_t Zlib6(const std::string& raw, double* seconds) {
 
 std::map<std::string, size_t> SectionSizes(const std::string& bytes) {
   std::map<std::string, size_t> sizes;
-  codec::ByteReader r(std::string_view(bytes).substr(8));
-  while (!r.AtEnd()) {
-    std::string_view tag, payload;
-    uint64_t n = 0;
-    if (!r.Bytes(4, &tag) || !r.U64(&n) || !r.Bytes(n, &payload)) break;
-    sizes[std::string(tag)] = 12 + n;
-  }
+  std::vector<codec::Section> sections;
+  codec::SplitSections(std::string_view(bytes).substr(8), &sections);
+  for (const codec::Section& s : sections) sizes[std::string(s.tag)] = 12 + s.payload.size();
   return sizes;
 }
 

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace svrc::codec {
 
@@ -106,5 +107,24 @@ class ByteReader {
   std::string_view in_;
   size_t pos_ = 0;
 };
+
+// One section of the container: 4-byte tag, u64 length, payload.
+struct Section {
+  std::string_view tag;
+  std::string_view payload;
+};
+
+// Splits `in` (a run of sections) into its sections, checking every length
+// against the bytes left. Returns false on a truncated or overlong section.
+inline bool SplitSections(std::string_view in, std::vector<Section>* out) {
+  ByteReader r(in);
+  while (!r.AtEnd()) {
+    Section s;
+    uint64_t length = 0;
+    if (!r.Bytes(4, &s.tag) || !r.U64(&length) || !r.Bytes(length, &s.payload)) return false;
+    out->push_back(s);
+  }
+  return true;
+}
 
 }  // namespace svrc::codec

@@ -343,20 +343,17 @@ absl::StatusOr<mesh::TetMesh> DecodeTetMesh(std::string_view bytes, const Decode
   std::string_view prov, counts, posl, posq, tets, tris;
   bool seen_prov = false, seen_counts = false, seen_posl = false, seen_posq = false,
        seen_tets = false, seen_tris = false;
-  ByteReader r(body.substr(kHeaderSize));
-  while (!r.AtEnd()) {
-    std::string_view tag_bytes, payload;
-    uint64_t length = 0;
-    if (!r.Bytes(4, &tag_bytes) || !r.U64(&length)) return Invalid("truncated section header");
-    if (!r.Bytes(length, &payload)) {
-      return Invalid(absl::StrCat("section '", absl::CEscape(std::string(tag_bytes)), "' length ", length, " exceeds the ",
-                                  r.remaining(), " bytes left"));
-    }
+  std::vector<Section> sections;
+  if (!SplitSections(body.substr(kHeaderSize), &sections)) {
+    return Invalid("a section's length runs past the end");
+  }
+  for (const Section& section : sections) {
+    const std::string_view tag_bytes = section.tag;
     const Tag tag = {tag_bytes[0], tag_bytes[1], tag_bytes[2], tag_bytes[3]};
     auto take = [&](bool* seen, std::string_view* slot) -> absl::Status {
       if (*seen) return Invalid(absl::StrCat("duplicate section '", std::string(tag_bytes), "'"));
       *seen = true;
-      *slot = payload;
+      *slot = section.payload;
       return absl::OkStatus();
     };
     absl::Status s;

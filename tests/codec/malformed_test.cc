@@ -56,13 +56,10 @@ struct Parts {
 Parts Split(const std::string& bytes) {
   Parts p;
   p.header = bytes.substr(0, 8);
-  ByteReader r(std::string_view(bytes).substr(8, bytes.size() - 8 - kHashSectionSize));
-  while (!r.AtEnd()) {
-    std::string_view tag, payload;
-    uint64_t n = 0;
-    EXPECT_TRUE(r.Bytes(4, &tag) && r.U64(&n) && r.Bytes(n, &payload));
-    p.sections.emplace_back(std::string(tag), std::string(payload));
-  }
+  std::vector<Section> sections;
+  EXPECT_TRUE(SplitSections(
+      std::string_view(bytes).substr(8, bytes.size() - 8 - kHashSectionSize), &sections));
+  for (const Section& s : sections) p.sections.emplace_back(s.tag, s.payload);
   return p;
 }
 
