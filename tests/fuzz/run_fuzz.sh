@@ -28,10 +28,14 @@ while IFS= read -r f; do
   case $target in
     plc_validate) { printf "\\x0$i"; cat "$f"; } > "$work/seeds/$name" ;;
     plc_medit) [[ $ext == mesh ]] && cp "$f" "$work/seeds/$name" ;;
+    plc_node) [[ $ext == node || $ext == poly ]] && cp "$f" "$work/seeds/$name" ;;  # .poly starts with a node section
     plc_*) [[ $ext == "${target#plc_}" ]] && cp "$f" "$work/seeds/$name" ;;
   esac
 done < <(find "$corpus" -type f | sort)
 case $target in
+  plc_medit)  # the corpus has no .mesh file: a tetrahedron's surface
+    printf 'MeshVersionFormatted 1\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\nTriangles\n4\n1 3 2 1\n1 2 4 2\n1 4 3 3\n2 3 4 4\nEnd\n' \
+      > "$work/seeds/tetra.mesh" ;;
   codec_*) cp "$src/tests/codec/data/reference_v1.svrc" "$work/seeds/" ;;
 esac
 # The regression inputs are seeds too.
