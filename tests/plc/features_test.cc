@@ -289,7 +289,9 @@ TEST(Features, TriangulationsCoverFacetsMinusHoles) {
       with_holes += holes;
       EXPECT_NEAR(tri, expect, 1e-9 * std::max(1.0, expect));
     }
-    if (std::string(rel) == "f_real/hinge.stl") EXPECT_EQ(with_holes, 7u);  // 7 merged-facet holes
+    if (std::string(rel) == "f_real/hinge.stl") {
+      EXPECT_EQ(with_holes, 7u);  // 7 merged-facet holes
+    }
   }
 }
 
