@@ -1,5 +1,8 @@
 #include "server/job_manager.h"
 
+#include <signal.h>
+
+#include <cstdlib>
 #include <utility>
 #include <vector>
 
@@ -33,6 +36,9 @@ v1::JobState StateFor(const absl::Status& status) {
 
 struct JobManager::JobRecord {
   uint64_t seq = 0;
+  std::string owner;
+  uint32_t attempts = 0;          // runs started (journaled before each)
+  bool requeue_on_restart = false;  // cancelled by Shutdown: journaled as QUEUED
   v1::Job job;
   uint64_t event_seq = 0;
   v1::SubmitJobRequest request;  // the input; moved out when the job starts
@@ -45,8 +51,15 @@ struct JobManager::JobRecord {
 };
 
 JobManager::JobManager(JobManagerOptions options, std::unique_ptr<JobQueue> queue,
-                       std::unique_ptr<ResultStore> store)
-    : options_(options), queue_(std::move(queue)), store_(std::move(store)) {
+                       std::unique_ptr<ResultStore> store, std::unique_ptr<Journal> journal)
+    : options_(options),
+      queue_(std::move(queue)),
+      store_(std::move(store)),
+      journal_(std::move(journal)) {
+  if (const char* crash = std::getenv("SVRC_TEST_CRASH_ON_INPUT"); crash != nullptr) {
+    crash_input_name_ = crash;
+  }
+  if (journal_ != nullptr) Recover();
   workers_ = std::make_unique<WorkerPool>(options_.workers, queue_.get(),
                                           [this](const std::string& id) { RunJob(id); });
   janitor_ = std::thread([this] { JanitorLoop(); });
@@ -54,7 +67,18 @@ JobManager::JobManager(JobManagerOptions options, std::unique_ptr<JobQueue> queu
 
 JobManager::~JobManager() { Shutdown(absl::ZeroDuration()); }
 
-absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request) {
+std::string JobManager::RequestKey(const std::string& owner, const std::string& request_id) {
+  return absl::StrCat(owner.size(), ":", owner, request_id);
+}
+
+JobManager::JobRecord* JobManager::Find(const std::string& job_id, const std::string& owner) {
+  auto it = jobs_.find(job_id);
+  // Another client's job looks exactly like a missing one (docs/security.md).
+  if (it == jobs_.end() || it->second->owner != owner) return nullptr;
+  return it->second.get();
+}
+
+absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request, const std::string& owner) {
   std::string input_name;
   uint64_t input_bytes = 0;
   v1::InputFormat input_format = v1::INPUT_FORMAT_UNSPECIFIED;
@@ -83,26 +107,66 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request) {
   if (!options.ok()) return options.status();
   const absl::Duration deadline = options->deadline;
 
-  absl::MutexLock lock(&mu_);
-  if (!accepting_) return absl::UnavailableError("server is shutting down; not accepting jobs");
-  if (!request.request_id().empty()) {
-    auto it = by_request_id_.find(request.request_id());
-    if (it != by_request_id_.end()) {
-      ServerLog().info("job {}: resubmission of request {} returns the existing job", it->second,
-                       request.request_id());
-      return jobs_.at(it->second)->job;
+  const std::string request_key = RequestKey(owner, request.request_id());
+  // Checks done before and again after the input is stored (outside the lock).
+  auto admit = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) -> absl::StatusOr<const JobRecord*> {
+    if (!accepting_) return absl::UnavailableError("server is shutting down; not accepting jobs");
+    if (!request.request_id().empty()) {
+      auto it = by_request_id_.find(request_key);
+      if (it != by_request_id_.end()) return jobs_.at(it->second).get();
+    }
+    if (options_.max_jobs_per_client > 0) {
+      int active = 0;
+      for (const auto& [jid, r] : jobs_) {
+        if (r->owner == owner && !api::IsTerminal(r->job.state())) ++active;
+      }
+      if (active >= options_.max_jobs_per_client) {
+        return absl::ResourceExhaustedError(absl::StrCat(
+            "this client already has ", active, " unfinished jobs (the limit is ",
+            options_.max_jobs_per_client, "); wait for one to finish"));
+      }
+    }
+    return nullptr;
+  };
+  std::string id;
+  {
+    absl::MutexLock lock(&mu_);
+    absl::StatusOr<const JobRecord*> existing = admit();
+    if (!existing.ok()) return existing.status();
+    if (*existing != nullptr) {
+      ServerLog().info("job {}: resubmission of its request id returns the existing job",
+                       (*existing)->job.job_id());
+      return (*existing)->job;
+    }
+    do {
+      id = absl::StrFormat("j%016x", absl::Uniform<uint64_t>(bitgen_));
+    } while (jobs_.contains(id));
+  }
+  // The input is on disk before the job is acknowledged, so that a re-queued
+  // job can run again after a crash. Written outside the lock: it may be big.
+  if (journal_ != nullptr) {
+    if (absl::Status s = journal_->PutInput(id, request); !s.ok()) {
+      ServerLog().error("job {}: cannot store its input: {}", id, std::string(s.message()));
+      return absl::UnavailableError(absl::StrCat("cannot store the input: ", s.message()));
     }
   }
-  std::string id;
-  do {
-    id = absl::StrFormat("j%016x", absl::Uniform<uint64_t>(bitgen_));
-  } while (jobs_.contains(id));
+  absl::MutexLock lock(&mu_);
+  {
+    absl::StatusOr<const JobRecord*> existing = admit();
+    if (!existing.ok() || *existing != nullptr) {
+      if (journal_ != nullptr) journal_->DeleteInput(id);
+      if (!existing.ok()) return existing.status();
+      return (*existing)->job;
+    }
+  }
   if (absl::Status s = queue_->Push(id); !s.ok()) {
     ServerLog().warn("submission refused: {}", std::string(s.message()));
+    if (journal_ != nullptr) journal_->DeleteInput(id);
     return s;
   }
   auto rec = std::make_unique<JobRecord>();
   rec->seq = next_seq_++;
+  rec->owner = owner;
   const absl::Time now = absl::Now();
   if (deadline > absl::ZeroDuration()) {
     rec->deadline = now + deadline;
@@ -121,24 +185,40 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request) {
   *job.mutable_parameters() = request.parameters();
   *job.mutable_encoding() = request.encoding();
   *job.mutable_limits() = request.limits();
+  if (journal_ != nullptr) {
+    // Accepted means durable: the record is on disk before the reply.
+    v1::JournalRecord r;
+    r.set_kind(v1::JournalRecord::SUBMITTED);
+    r.set_job_id(id);
+    *r.mutable_job() = job;
+    r.set_owner(owner);
+    if (absl::Status s = journal_->Append(r, /*sync=*/true); !s.ok()) {
+      queue_->Remove(id);
+      journal_->DeleteInput(id);
+      ServerLog().error("job {}: cannot journal the submission: {}", id, std::string(s.message()));
+      return absl::UnavailableError(absl::StrCat("cannot journal the job: ", s.message()));
+    }
+  }
   rec->request = std::move(request);
-  if (!job.request_id().empty()) by_request_id_[job.request_id()] = id;
+  if (!job.request_id().empty()) by_request_id_[request_key] = id;
   order_[rec->seq] = id;
   ServerLog().info("job {}: queued ({} {} bytes, queue {}/{})", id, input_name, input_bytes,
                    queue_->Size(), queue_->Capacity());
   v1::Job snapshot = job;
   jobs_[id] = std::move(rec);
+  if (journal_ != nullptr && journal_->appended_since_rewrite() >= options_.compact_every) Compact();
   return snapshot;
 }
 
-absl::StatusOr<v1::Job> JobManager::Get(const std::string& job_id) {
+absl::StatusOr<v1::Job> JobManager::Get(const std::string& job_id, const std::string& owner) {
   absl::MutexLock lock(&mu_);
-  auto it = jobs_.find(job_id);
-  if (it == jobs_.end()) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  return it->second->job;
+  JobRecord* rec = Find(job_id, owner);
+  if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  return rec->job;
 }
 
-absl::StatusOr<v1::ListJobsResponse> JobManager::List(const v1::ListJobsRequest& request) {
+absl::StatusOr<v1::ListJobsResponse> JobManager::List(const v1::ListJobsRequest& request,
+                                                      const std::string& owner) {
   int page_size = request.page_size() <= 0 ? 100 : std::min(request.page_size(), 1000);
   uint64_t start = 0;
   if (!request.page_token().empty() && !absl::SimpleAtoi(request.page_token(), &start)) {
@@ -154,8 +234,9 @@ absl::StatusOr<v1::ListJobsResponse> JobManager::List(const v1::ListJobsRequest&
   v1::ListJobsResponse out;
   absl::MutexLock lock(&mu_);
   for (auto it = order_.lower_bound(start); it != order_.end(); ++it) {
-    const v1::Job& job = jobs_.at(it->second)->job;
-    if (!wanted(job.state())) continue;
+    const JobRecord& rec = *jobs_.at(it->second);
+    const v1::Job& job = rec.job;
+    if (rec.owner != owner || !wanted(job.state())) continue;
     if (out.jobs_size() == page_size) {
       out.set_next_page_token(absl::StrCat(it->first));
       break;
@@ -165,11 +246,10 @@ absl::StatusOr<v1::ListJobsResponse> JobManager::List(const v1::ListJobsRequest&
   return out;
 }
 
-absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& job_id) {
+absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& job_id, const std::string& owner) {
   absl::MutexLock lock(&mu_);
-  auto it = jobs_.find(job_id);
-  if (it == jobs_.end()) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  JobRecord* rec = it->second.get();
+  JobRecord* rec = Find(job_id, owner);
+  if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   if (api::IsTerminal(rec->job.state())) return rec->job;
   rec->cancel.Cancel();
   rec->job.set_cancel_requested(true);
@@ -182,28 +262,32 @@ absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& job_id) {
   return rec->job;
 }
 
-absl::Status JobManager::Delete(const std::string& job_id) {
+absl::Status JobManager::Delete(const std::string& job_id, const std::string& owner) {
   absl::MutexLock lock(&mu_);
+  JobRecord* rec = Find(job_id, owner);
+  if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   auto it = jobs_.find(job_id);
-  if (it == jobs_.end()) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  JobRecord* rec = it->second.get();
   if (!api::IsTerminal(rec->job.state())) {
     return absl::FailedPreconditionError(absl::StrCat(
         "job ", job_id, " is ", api::JobStateName(rec->job.state()), "; cancel it first"));
   }
   if (absl::Status s = store_->Delete(job_id); !s.ok()) return s;
+  v1::JournalRecord r;
+  r.set_kind(v1::JournalRecord::DELETED);
+  r.set_job_id(job_id);
+  JournalAppend(std::move(r), /*sync=*/false);
   order_.erase(rec->seq);
-  if (!rec->job.request_id().empty()) by_request_id_.erase(rec->job.request_id());
+  if (!rec->job.request_id().empty()) by_request_id_.erase(RequestKey(rec->owner, rec->job.request_id()));
   jobs_.erase(it);
   ServerLog().info("job {}: deleted", job_id);
   return absl::OkStatus();
 }
 
-absl::StatusOr<uint64_t> JobManager::Subscribe(const std::string& job_id, Listener listener) {
+absl::StatusOr<uint64_t> JobManager::Subscribe(const std::string& job_id, Listener listener,
+                                               const std::string& owner) {
   absl::MutexLock lock(&mu_);
-  auto it = jobs_.find(job_id);
-  if (it == jobs_.end()) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  JobRecord* rec = it->second.get();
+  JobRecord* rec = Find(job_id, owner);
+  if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const uint64_t token = next_token_++;
   v1::JobEvent event;
   *event.mutable_job() = rec->job;
@@ -219,11 +303,12 @@ void JobManager::Unsubscribe(const std::string& job_id, uint64_t token) {
   if (it != jobs_.end()) it->second->listeners.erase(token);
 }
 
-absl::StatusOr<StoredResult> JobManager::Result(const std::string& job_id) {
+absl::StatusOr<StoredResult> JobManager::Result(const std::string& job_id,
+                                               const std::string& owner) {
   absl::MutexLock lock(&mu_);
-  auto it = jobs_.find(job_id);
-  if (it == jobs_.end()) return absl::NotFoundError(absl::StrCat("no job ", job_id));
-  const v1::Job& job = it->second->job;
+  JobRecord* rec = Find(job_id, owner);
+  if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
+  const v1::Job& job = rec->job;
   if (job.state() != v1::SUCCEEDED) {
     std::string why = absl::StrCat("job ", job_id, " is ", api::JobStateName(job.state()));
     if (job.has_error()) absl::StrAppend(&why, ": ", job.error().message());
@@ -258,12 +343,31 @@ void JobManager::Notify(JobRecord* rec) {
 
 void JobManager::Finish(JobRecord* rec, const absl::Status& status) {
   v1::Job& job = rec->job;
+  if (journal_ != nullptr && rec->requeue_on_restart && !status.ok()) {
+    // Cancelled by a shutdown: the job is not over; the next server runs it
+    // again (the interrupted attempt does not count as a crash).
+    if (job.state() == v1::RUNNING && rec->attempts > 0) --rec->attempts;
+    job.set_state(v1::QUEUED);
+    job.mutable_progress()->set_phase("queued");
+    JournalAppend(SnapshotOf(*rec), /*sync=*/true);
+    ServerLog().info("job {}: interrupted by the shutdown; queued for the next start", job.job_id());
+    Notify(rec);
+    return;
+  }
   job.set_state(StateFor(status));
   if (status.ok()) job.mutable_progress()->set_phase("done");
   if (!status.ok()) *job.mutable_error() = ToProtoStatus(status);
   rec->ended = absl::Now();
   *job.mutable_end_time() = ToTimestamp(rec->ended);
   rec->request.Clear();
+  if (journal_ != nullptr) {
+    v1::JournalRecord r;
+    r.set_kind(v1::JournalRecord::FINISHED);
+    r.set_job_id(job.job_id());
+    *r.mutable_job() = job;
+    JournalAppend(std::move(r), /*sync=*/true);
+    journal_->DeleteInput(job.job_id());
+  }
   if (status.ok()) {
     ServerLog().info("job {}: SUCCEEDED ({} vertices, {} tets, {} bytes) in {:.3f} s",
                      job.job_id(), job.result().num_vertices(), job.result().num_tets(),
@@ -301,6 +405,7 @@ void JobManager::RunJob(const std::string& job_id) {
     if (it == jobs_.end() || it->second->job.state() != v1::QUEUED) return;
     rec = it->second.get();
     if (!accepting_) {
+      if (draining_) return;  // stays QUEUED in the journal: the next server runs it
       Finish(rec, absl::CancelledError("server shutting down"));
       return;
     }
@@ -309,6 +414,20 @@ void JobManager::RunJob(const std::string& job_id) {
                       ? absl::DeadlineExceededError("job deadline exceeded while queued")
                       : absl::CancelledError("job cancelled before it started"));
       return;
+    }
+    ++rec->attempts;
+    if (journal_ != nullptr) {
+      // On disk before the run: if this attempt takes the server down, the
+      // next start counts it (max_attempts) instead of looping.
+      v1::JournalRecord r;
+      r.set_kind(v1::JournalRecord::STARTED);
+      r.set_job_id(job_id);
+      r.set_attempt(rec->attempts);
+      JournalAppend(std::move(r), /*sync=*/true);
+    }
+    if (!crash_input_name_.empty() && rec->job.input_name() == crash_input_name_) {
+      ServerLog().warn("job {}: SVRC_TEST_CRASH_ON_INPUT matches; killing the server", job_id);
+      ::raise(SIGKILL);
     }
     rec->started = absl::Now();
     rec->job.set_state(v1::RUNNING);
@@ -414,8 +533,14 @@ void JobManager::JanitorLoop() {
     for (const std::string& id : expired) {
       auto it = jobs_.find(id);
       store_->Delete(id).IgnoreError();
+      v1::JournalRecord r;
+      r.set_kind(v1::JournalRecord::DELETED);
+      r.set_job_id(id);
+      JournalAppend(std::move(r), /*sync=*/false);
       order_.erase(it->second->seq);
-      if (!it->second->job.request_id().empty()) by_request_id_.erase(it->second->job.request_id());
+      if (!it->second->job.request_id().empty()) {
+        by_request_id_.erase(RequestKey(it->second->owner, it->second->job.request_id()));
+      }
       jobs_.erase(it);
       ServerLog().info("job {}: expired after the retention time", id);
     }
@@ -429,18 +554,175 @@ void JobManager::JanitorLoop() {
   }
 }
 
+void JobManager::JournalAppend(v1::JournalRecord record, bool sync) {
+  if (journal_ == nullptr) return;
+  if (absl::Status s = journal_->Append(record, sync); !s.ok()) {
+    ServerLog().error("journal: cannot record job {}: {}", record.job_id(), std::string(s.message()));
+  }
+}
+
+v1::JournalRecord JobManager::SnapshotOf(const JobRecord& rec) const {
+  v1::JournalRecord r;
+  r.set_kind(v1::JournalRecord::SNAPSHOT);
+  r.set_job_id(rec.job.job_id());
+  *r.mutable_job() = rec.job;
+  r.set_owner(rec.owner);
+  r.set_attempt(rec.attempts);
+  return r;
+}
+
+void JobManager::Compact() {
+  std::vector<v1::JournalRecord> records;
+  records.reserve(order_.size());
+  for (const auto& [seq, id] : order_) records.push_back(SnapshotOf(*jobs_.at(id)));
+  if (absl::Status s = journal_->Rewrite(records); !s.ok()) {
+    ServerLog().error("journal: compaction failed: {}", std::string(s.message()));
+  } else {
+    ServerLog().info("journal: compacted to {} job snapshots", records.size());
+  }
+}
+
+void JobManager::Recover() {
+  struct Replayed {
+    v1::Job job;
+    std::string owner;
+    uint32_t attempts = 0;
+  };
+  std::vector<std::string> order;  // first appearance = submission order
+  absl::flat_hash_map<std::string, Replayed> replayed;
+  std::vector<v1::JournalRecord> records = journal_->TakeReplayed();
+  if (journal_->dropped_tail_bytes() > 0) {
+    ServerLog().warn("journal: dropped a torn or corrupt tail of {} bytes",
+                     journal_->dropped_tail_bytes());
+  }
+  for (v1::JournalRecord& r : records) {
+    auto it = replayed.find(r.job_id());
+    switch (r.kind()) {
+      case v1::JournalRecord::SUBMITTED:
+      case v1::JournalRecord::SNAPSHOT:
+        if (it == replayed.end()) {
+          order.push_back(r.job_id());
+          it = replayed.emplace(r.job_id(), Replayed{}).first;
+        }
+        it->second.job = std::move(*r.mutable_job());
+        it->second.owner = r.owner();
+        it->second.attempts = r.attempt();
+        break;
+      case v1::JournalRecord::STARTED:
+        if (it != replayed.end()) {
+          it->second.attempts = r.attempt();
+          it->second.job.set_state(v1::RUNNING);
+        }
+        break;
+      case v1::JournalRecord::FINISHED:
+        if (it != replayed.end()) it->second.job = std::move(*r.mutable_job());
+        break;
+      case v1::JournalRecord::DELETED:
+        if (it != replayed.end()) replayed.erase(it);
+        break;
+      default:
+        break;
+    }
+  }
+  const absl::Time now = absl::Now();
+  int requeued = 0, failed = 0, kept = 0;
+  absl::MutexLock lock(&mu_);
+  for (const std::string& id : order) {
+    auto it = replayed.find(id);
+    if (it == replayed.end() || jobs_.contains(id)) continue;
+    Replayed& r = it->second;
+    auto rec = std::make_unique<JobRecord>();
+    rec->seq = next_seq_++;
+    rec->owner = r.owner;
+    rec->attempts = r.attempts;
+    rec->job = std::move(r.job);
+    v1::Job& job = rec->job;
+    if (api::IsTerminal(job.state())) {
+      rec->ended = absl::FromUnixNanos(TimeUtil::TimestampToNanoseconds(job.end_time()));
+      if (rec->ended + options_.retention <= now) {
+        store_->Delete(id).IgnoreError();
+        continue;
+      }
+      ++kept;
+    }
+    JobRecord* p = rec.get();
+    order_[p->seq] = id;
+    if (!job.request_id().empty()) by_request_id_[RequestKey(p->owner, job.request_id())] = id;
+    jobs_[id] = std::move(rec);
+    if (api::IsTerminal(job.state())) continue;
+
+    // An interrupted job: run it again unless it keeps killing the server.
+    const bool was_running = job.state() == v1::RUNNING;
+    job.set_state(v1::QUEUED);
+    job.mutable_progress()->Clear();
+    job.mutable_progress()->set_phase("queued");
+    job.clear_start_time();
+    store_->Delete(id).IgnoreError();  // a result the crashed attempt may have left
+    ++failed;
+    if (was_running && static_cast<int>(p->attempts) >= options_.max_attempts) {
+      Finish(p, absl::InternalError(absl::StrCat(
+                    "the server died ", p->attempts,
+                    " times while running this job; it is not run again")));
+      continue;
+    }
+    if (job.cancel_requested()) {
+      Finish(p, absl::CancelledError("job cancelled before the server restarted"));
+      continue;
+    }
+    if (job.limits().has_deadline()) {
+      const absl::Duration d = absl::Nanoseconds(TimeUtil::DurationToNanoseconds(job.limits().deadline()));
+      if (d > absl::ZeroDuration()) {
+        p->deadline = absl::FromUnixNanos(TimeUtil::TimestampToNanoseconds(job.create_time())) + d;
+        if (p->deadline <= now) {
+          Finish(p, absl::DeadlineExceededError("job deadline passed while the server was down"));
+          continue;
+        }
+        p->cancel.SetDeadline(std::chrono::steady_clock::now() +
+                              absl::ToChronoNanoseconds(p->deadline - now));
+      }
+    }
+    absl::StatusOr<v1::SubmitJobRequest> input = journal_->GetInput(id);
+    if (!input.ok()) {
+      Finish(p, absl::DataLossError(std::string(input.status().message())));
+      continue;
+    }
+    p->request = *std::move(input);
+    if (absl::Status s = queue_->Push(id); !s.ok()) {
+      Finish(p, absl::ResourceExhaustedError(
+                    absl::StrCat("cannot re-queue the job after a restart: ", s.message())));
+      continue;
+    }
+    --failed;
+    ++requeued;
+    ServerLog().info("job {}: re-queued after a restart ({} attempts so far)", id, p->attempts);
+  }
+  // Inputs no unfinished job refers to (their job finished or was deleted
+  // just before a crash).
+  for (const std::string& id : journal_->ListInputs()) {
+    auto it = jobs_.find(id);
+    if (it == jobs_.end() || api::IsTerminal(it->second->job.state())) journal_->DeleteInput(id);
+  }
+  Compact();
+  ServerLog().info("journal: recovered {} finished jobs, re-queued {}, failed {}", kept, requeued,
+                   failed);
+}
+
 void JobManager::Shutdown(absl::Duration grace) {
   {
     absl::MutexLock lock(&mu_);
     if (stopped_) return;
     accepting_ = false;
+    draining_ = journal_ != nullptr;
   }
   std::vector<std::string> queued = queue_->Close();
   {
     absl::MutexLock lock(&mu_);
     for (const std::string& id : queued) {
       auto it = jobs_.find(id);
-      if (it != jobs_.end()) Finish(it->second.get(), absl::CancelledError("server shutting down"));
+      // With a journal, queued jobs stay queued for the next start.
+      if (it != jobs_.end() && !draining_) {
+        Finish(it->second.get(), absl::CancelledError("server shutting down"));
+      }
     }
     ServerLog().info("shutdown: {} queued jobs cancelled, waiting up to {} for {} running",
                      queued.size(), absl::FormatDuration(grace), running_);
@@ -449,6 +731,7 @@ void JobManager::Shutdown(absl::Duration grace) {
       for (auto& [id, rec] : jobs_) {
         if (rec->job.state() == v1::RUNNING) {
           ServerLog().info("job {}: cancelled at the end of the shutdown grace period", id);
+          rec->requeue_on_restart = draining_;
           rec->cancel.Cancel();
           rec->job.set_cancel_requested(true);
         }

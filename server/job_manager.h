@@ -1,7 +1,11 @@
 // The job service without gRPC: a table of jobs, the queue, the workers that
 // run core::MeshPlc, progress fanned out to watchers, cancellation through
 // core::CancelToken, deadlines, retention. service.cc adapts it to gRPC;
-// tests drive it directly. DESIGN.md "Data flow".
+// tests drive it directly. With a Journal, every accepted job survives a
+// crash (kill -9) of the server: see Recover() and docs/service.md
+// "Persistence". Jobs belong to the client that submitted them (`owner`,
+// "" without authentication); another client's job is NOT_FOUND.
+// DESIGN.md "Data flow".
 #pragma once
 
 #include <cstdint>
@@ -20,6 +24,7 @@
 #include "absl/time/time.h"
 #include "core/api.h"
 #include "server/job_queue.h"
+#include "server/journal.h"
 #include "server/result_store.h"
 #include "server/worker_pool.h"
 #include "svrc/v1/service.pb.h"
@@ -36,6 +41,19 @@ struct JobManagerOptions {
   absl::Duration retention = absl::Hours(24);
   // How often queued deadlines and retention are checked.
   absl::Duration janitor_interval = absl::Milliseconds(200);
+  // A job that was running when the server died this many times is FAILED
+  // at recovery instead of being run again (a job that crashes the server
+  // must not crash it forever).
+  int max_attempts = 2;
+  // The journal is compacted (rewritten as one snapshot per job) after this
+  // many appended records.
+  uint64_t compact_every = 4096;
+  // Queued + running jobs one client may have; 0: unlimited.
+  int max_jobs_per_client = 0;
+  // Heap bytes one job may hold (accounted per worker thread, see
+  // server/memory_accounting.h); 0: unlimited. Over it the job ends
+  // FAILED with RESOURCE_EXHAUSTED.
+  uint64_t max_job_memory_bytes = 0;
 };
 
 class JobManager {
@@ -44,27 +62,34 @@ class JobManager {
   // block or call back into the manager.
   using Listener = std::function<void(const v1::JobEvent& event)>;
 
+  // With a `journal`, the jobs it holds are recovered first: finished ones
+  // are served again, interrupted ones re-queued (or FAILED after
+  // max_attempts crashes), and every later change is journaled.
   JobManager(JobManagerOptions options, std::unique_ptr<JobQueue> queue,
-             std::unique_ptr<ResultStore> store);
+             std::unique_ptr<ResultStore> store, std::unique_ptr<Journal> journal = nullptr);
   // Calls Shutdown(zero) if it was not called.
   ~JobManager();
 
   // Validates the request shape and parameters, then queues the job. The
   // input is moved out of `request`. Same request_id as an earlier job: that
   // job. RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE when draining.
-  absl::StatusOr<v1::Job> Submit(v1::SubmitJobRequest request);
-  absl::StatusOr<v1::Job> Get(const std::string& job_id);
-  absl::StatusOr<v1::ListJobsResponse> List(const v1::ListJobsRequest& request);
-  absl::StatusOr<v1::Job> Cancel(const std::string& job_id);
-  absl::Status Delete(const std::string& job_id);
+  // RESOURCE_EXHAUSTED too when `owner` has max_jobs_per_client unfinished
+  // jobs. Request ids are per owner.
+  absl::StatusOr<v1::Job> Submit(v1::SubmitJobRequest request, const std::string& owner = "");
+  absl::StatusOr<v1::Job> Get(const std::string& job_id, const std::string& owner = "");
+  absl::StatusOr<v1::ListJobsResponse> List(const v1::ListJobsRequest& request,
+                                            const std::string& owner = "");
+  absl::StatusOr<v1::Job> Cancel(const std::string& job_id, const std::string& owner = "");
+  absl::Status Delete(const std::string& job_id, const std::string& owner = "");
 
   // Calls `listener` at once with the current state, then on every change
   // until Unsubscribe. Returns the subscription token.
-  absl::StatusOr<uint64_t> Subscribe(const std::string& job_id, Listener listener);
+  absl::StatusOr<uint64_t> Subscribe(const std::string& job_id, Listener listener,
+                                     const std::string& owner = "");
   void Unsubscribe(const std::string& job_id, uint64_t token);
 
   // The stored result of a SUCCEEDED job (FAILED_PRECONDITION otherwise).
-  absl::StatusOr<StoredResult> Result(const std::string& job_id);
+  absl::StatusOr<StoredResult> Result(const std::string& job_id, const std::string& owner = "");
   ResultStore* store() { return store_.get(); }
 
   // Stops accepting jobs, cancels the queued ones, lets running jobs finish
@@ -75,6 +100,17 @@ class JobManager {
 
  private:
   struct JobRecord;
+
+  // The job `job_id` if it exists and belongs to `owner`.
+  JobRecord* Find(const std::string& job_id, const std::string& owner)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Rebuilds the job table from the journal (constructor, before the workers).
+  void Recover();
+  // Journal helpers; failures are logged (the in-memory state stays right).
+  void JournalAppend(v1::JournalRecord record, bool sync) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  v1::JournalRecord SnapshotOf(const JobRecord& rec) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void Compact() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  static std::string RequestKey(const std::string& owner, const std::string& request_id);
 
   void RunJob(const std::string& job_id);
   absl::Status Execute(JobRecord* rec, const v1::SubmitJobRequest& request,
@@ -88,6 +124,8 @@ class JobManager {
   const JobManagerOptions options_;
   std::unique_ptr<JobQueue> queue_;
   std::unique_ptr<ResultStore> store_;
+  std::unique_ptr<Journal> journal_;  // null: nothing survives a restart
+  std::string crash_input_name_;  // test hook SVRC_TEST_CRASH_ON_INPUT (docs/service.md)
 
   mutable absl::Mutex mu_;
   absl::flat_hash_map<std::string, std::unique_ptr<JobRecord>> jobs_ ABSL_GUARDED_BY(mu_);
@@ -99,6 +137,7 @@ class JobManager {
   int running_ ABSL_GUARDED_BY(mu_) = 0;
   bool accepting_ ABSL_GUARDED_BY(mu_) = true;
   bool stopped_ ABSL_GUARDED_BY(mu_) = false;
+  bool draining_ ABSL_GUARDED_BY(mu_) = false;  // Shutdown with a journal: jobs stay queued
 
   std::unique_ptr<WorkerPool> workers_;
   std::thread janitor_;

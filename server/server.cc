@@ -21,6 +21,8 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   absl::StatusOr<std::unique_ptr<DiskResultStore>> store =
       DiskResultStore::Open(options.data_dir, options.disk_quota_bytes);
   if (!store.ok()) return store.status();
+  absl::StatusOr<std::unique_ptr<Journal>> journal = Journal::Open(options.data_dir);
+  if (!journal.ok()) return journal.status();
 
   std::unique_ptr<Server> server(new Server());
   server->options_ = options;
@@ -30,7 +32,8 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   jm.retention = options.retention;
   jm.progress_interval = options.progress_interval;
   server->manager_ = std::make_unique<JobManager>(
-      jm, std::make_unique<InMemoryJobQueue>(options.queue_capacity), *std::move(store));
+      jm, std::make_unique<InMemoryJobQueue>(options.queue_capacity), *std::move(store),
+      *std::move(journal));
   server->service_ =
       std::make_unique<MeshingServiceImpl>(server->manager_.get(), options.max_upload_bytes);
 
