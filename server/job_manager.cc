@@ -348,6 +348,7 @@ void JobManager::Finish(JobRecord* rec, const absl::Status& status) {
     // again (the interrupted attempt does not count as a crash).
     if (job.state() == v1::RUNNING && rec->attempts > 0) --rec->attempts;
     job.set_state(v1::QUEUED);
+    job.set_cancel_requested(false);  // set by Shutdown, not by the client
     job.mutable_progress()->set_phase("queued");
     JournalAppend(SnapshotOf(*rec), /*sync=*/true);
     ServerLog().info("job {}: interrupted by the shutdown; queued for the next start", job.job_id());

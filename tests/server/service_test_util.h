@@ -14,6 +14,12 @@ namespace svrc::testing {
 class ServerProcess {
  public:
   explicit ServerProcess(const std::vector<std::string>& extra_args = {});
+  // On an existing data dir (a restart); `env` adds NAME=VALUE variables.
+  // The dir is left in place (its owner removes it).
+  // `may_die`: the process may exit before it reports its address (a test
+  // crash hook) without failing the test.
+  ServerProcess(const std::vector<std::string>& extra_args, const std::string& data_dir,
+                const std::vector<std::string>& env = {}, bool may_die = false);
   // SIGTERM, then SIGKILL if it has not exited after 30 s.
   ~ServerProcess();
 
@@ -24,11 +30,20 @@ class ServerProcess {
   // Sends SIGTERM and waits up to `timeout_s`; returns the exit status
   // (-1 on timeout or signal death).
   int Terminate(double timeout_s);
+  // SIGKILL, and reaps it.
+  void Kill9();
+  // Waits up to `timeout_s` for the process to exit on its own; returns true
+  // if it died by SIGKILL (a test crash hook), false otherwise.
+  bool WaitKilled(double timeout_s);
   // The server's stderr so far (its log).
   std::string Log() const;
 
  private:
+  void Start(const std::vector<std::string>& extra_args, const std::vector<std::string>& env,
+             bool may_die);
+
   pid_t pid_ = -1;
+  bool own_data_dir_ = true;
   std::string address_;
   std::string data_dir_;
   std::string log_path_;
