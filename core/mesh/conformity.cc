@@ -610,9 +610,16 @@ class Checker {
         rep_->enclosed_volume_known = true;
       }
     } else {
-      ComputeEnclosedVolume();
+      BuildCells();
+      if (!cells_known_) ComputeEnclosedVolume();
     }
+    rep_->cells_known = cells_known_;
+    rep_->num_cells = cells_known_ ? static_cast<size_t>(num_bounded_cells_) : 0;
+    if (!cells_known_) rep_->cells_unknown_reason = cells_reason_;
     if (!rep_->enclosed_volume_known) return;
+    // Cell by cell subsumes the total (the cells' volumes add up to it); the
+    // total is the fallback when a component could not be located.
+    if (cells_known_ && CheckCellCoverage()) return;
     const double ve = rep_->enclosed_volume, vm = rep_->mesh_volume;
     if (std::fabs(vm - ve) > opt_.volume_rel_tol * std::fabs(ve)) {
       Add(rep_, opt_, ViolationKind::kVolumeMismatch, {},
@@ -788,6 +795,444 @@ class Checker {
     rep_->enclosed_volume_known = true;
   }
 
+  // ------------------------------------------------ cells of the facet arrangement
+  //
+  // docs/conformity.md "Cells of the facet arrangement". Each valid facet has
+  // two sides (nodes 2f: Orient3d(a,b,c,x) > 0, 2f+1: < 0). Around every
+  // polygon edge the facets' half-planes ("wings") are sorted by angle with
+  // exact Orient3d; consecutive wings bound one wedge, so the facing sides
+  // belong to the same cell: union them. Components are shells; a shell with
+  // positive outward volume is the outer boundary of one bounded cell, a
+  // negative one bounds a cell from inside (the unbounded cell or a cavity)
+  // and belongs to the innermost positive shell containing a point of it.
+
+  static int Sgn(double x) { return x > 0 ? 1 : (x < 0 ? -1 : 0); }
+
+  // Orient3d(a,b,c,x) > 0 lies along sigma_[f] * n.
+  int PlaneSigma(const FacetGeom& fg) const {
+    const Vec3 y = fg.plane.a + fg.plane.n * cell_len_;
+    return geom::Orient3d(fg.plane.a, fg.plane.b, fg.plane.c, y);
+  }
+
+  uint32_t Find(std::vector<uint32_t>& uf, uint32_t x) const {
+    while (uf[x] != x) x = uf[x] = uf[uf[x]];
+    return x;
+  }
+
+  // A point strictly inside facet f's region (off every loop), or false.
+  bool FacetInteriorPoint(const FacetGeom& fg, Vec3* out) const {
+    const int axis = fg.plane.axis;
+    for (const Loop& l : fg.loops) {
+      if (!l.outer || l.hole) continue;
+      for (size_t i = 1; i + 1 < l.pts.size(); ++i) {
+        const Vec3 g = (l.pts[0] + l.pts[i] + l.pts[i + 1]) / 3.0;
+        bool ok = InFacetRegion(fg, g);
+        for (const Loop& m : fg.loops) ok = ok && PointInLoop(m.pts, g, axis) != 0;
+        if (ok) {
+          *out = g;
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+  // Winding number of p with respect to shell s, oriented outward.
+  double ShellWinding(size_t s, const Vec3& p) const {
+    double total = 0;
+    for (uint32_t node : shell_nodes_[s]) {
+      const uint32_t f = node / 2;
+      const int side = node % 2 == 0 ? 1 : -1;
+      const FacetGeom& fg = facets_[f];
+      const Vec3 out = -(side * facet_sigma_[f]) * fg.plane.n;
+      for (const Loop& l : fg.loops) {
+        if (l.outer == l.hole) continue;
+        const int sign = (Dot(VectorArea(l.pts), out) > 0 ? 1 : -1) * (l.hole ? -1 : 1);
+        const Vec3 a = l.pts[0] - p;
+        for (size_t i = 1; i + 1 < l.pts.size(); ++i) {
+          const Vec3 b = l.pts[i] - p, c = l.pts[i + 1] - p;
+          // Van Oosterom & Strackee (1983): tan(Ω/2) = det / denominator.
+          const double la = Norm(a), lb = Norm(b), lc = Norm(c);
+          const double num = Dot(a, Cross(b, c));
+          const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
+          total += sign * 2 * std::atan2(num, den);
+        }
+      }
+    }
+    return total / (4 * 3.14159265358979323846);
+  }
+
+  // Rounded winding number of p w.r.t. shell s; -1 when p is (nearly) on it.
+  int ShellInside(size_t s, const Vec3& p) const {
+    const double w = ShellWinding(s, p);
+    const double r = std::round(w);
+    if (std::fabs(w - r) >= 0.25) return -1;
+    return static_cast<int>(std::fabs(r));
+  }
+
+  // The cell containing p (a point on no facet): the positive shell of least
+  // volume whose winding number at p is 1, or the unbounded cell. -1 when p
+  // is (nearly) on a facet. `skip_facet`: shells holding a side of this facet
+  // are not asked (p lies on it).
+  int32_t LocateCell(const Vec3& p, uint32_t skip_facet = kNone) const {
+    int32_t best = num_bounded_cells_;
+    for (size_t s = 0; s < shell_nodes_.size(); ++s) {
+      const int32_t c = shell_cell_of_positive_[s];
+      if (c < 0) continue;
+      if (skip_facet != kNone && (node_shell_[2 * skip_facet] == s ||
+                                  node_shell_[2 * skip_facet + 1] == s)) {
+        continue;
+      }
+      const int in = ShellInside(s, p);
+      if (in < 0 || in > 1) return -1;
+      if (in == 1 && (best == num_bounded_cells_ || shell_volume_[s] < cell_outer_volume_[best])) {
+        best = c;
+      }
+    }
+    return best;
+  }
+
+  // Builds the cells; leaves cells_known_ false (with a reason) when the
+  // arrangement is outside what this handles (docs/conformity.md).
+  void BuildCells() {
+    const size_t nf = facets_.size();
+    if (nf == 0) return;
+    Box3 plc_box;
+    for (const Vec3& p : plc_->vertices) plc_box.Add(p);
+    cell_origin_ = plc_box.Center();
+    cell_len_ = std::max(1.0, Norm(plc_box.hi - plc_box.lo));
+    facet_sigma_.assign(nf, 0);
+    std::vector<uint8_t> present(nf, 0);
+    struct Wing {
+      std::array<uint32_t, 2> key;
+      uint32_t facet;
+      Vec3 q;  // a point of the facet strictly on its interior side of the edge
+    };
+    std::vector<Wing> wings;
+    std::vector<std::array<uint32_t, 2>> inner_edges;  // subdivision loops, 2-vertex polygons
+    for (size_t f = 0; f < nf; ++f) {
+      const FacetGeom& fg = facets_[f];
+      if (!fg.valid) return cells_reason_ = "an invalid facet", void();
+      int outers = 0;
+      for (const Loop& l : fg.loops) outers += l.outer && !l.hole ? 1 : 0;
+      if (outers == 0) continue;  // nothing left of the facet
+      if (outers > 1) return cells_reason_ = "a facet with several outer polygons", void();
+      present[f] = 1;
+      facet_sigma_[f] = PlaneSigma(fg);
+      if (facet_sigma_[f] == 0) return cells_reason_ = "a degenerate facet plane", void();
+      const int axis = fg.plane.axis;
+      for (const Loop& l : fg.loops) {
+        const size_t n = l.ids.size();
+        if (l.outer && l.hole) continue;
+        if (!l.outer && !l.hole) {
+          for (size_t i = 0; i < n; ++i) {
+            const uint32_t u = l.ids[i], v = l.ids[(i + 1) % n];
+            inner_edges.push_back({std::min(u, v), std::max(u, v)});
+          }
+          continue;
+        }
+        double area2 = 0;
+        for (size_t i = 0; i < n; ++i) {
+          const Vec3 &p = l.pts[i], &r = l.pts[(i + 1) % n];
+          area2 += U(p, axis) * V(r, axis) - U(r, axis) * V(p, axis);
+        }
+        const int m = Sgn(area2) * (l.hole ? -1 : 1);
+        if (m == 0) return cells_reason_ = "a degenerate facet polygon", void();
+        for (size_t i = 0; i < n; ++i) {
+          const uint32_t u = l.ids[i], v = l.ids[(i + 1) % n];
+          if (u == v) continue;
+          const Vec3 &pu = l.pts[i], &pv = l.pts[(i + 1) % n];
+          // The facet lies left of u->v (projected) when m > 0: any facet
+          // vertex strictly on that side represents the half-plane.
+          bool found = false;
+          Vec3 q;
+          for (const Loop& k : fg.loops) {
+            for (const Vec3& w : k.pts) {
+              if (geom::Orient2dProjected(pu, pv, w, axis) * m > 0) {
+                q = w;
+                found = true;
+                break;
+              }
+            }
+            if (found) break;
+          }
+          if (!found) return cells_reason_ = "a facet edge with no facet point beside it", void();
+          wings.push_back({{std::min(u, v), std::max(u, v)}, static_cast<uint32_t>(f), q});
+        }
+      }
+    }
+    for (const auto& poly_facet : plc_->facets) {
+      for (const auto& poly : poly_facet.polygons) {
+        if (poly.vertices.size() == 2) {
+          inner_edges.push_back({std::min(poly.vertices[0], poly.vertices[1]),
+                                 std::max(poly.vertices[0], poly.vertices[1])});
+        }
+      }
+    }
+    std::sort(wings.begin(), wings.end(), [](const Wing& a, const Wing& b) {
+      return a.key != b.key ? a.key < b.key : a.facet < b.facet;
+    });
+    // An edge inside a facet that other facets end on splits that facet's
+    // sides into pieces: not handled.
+    for (const auto& e : inner_edges) {
+      auto it = std::lower_bound(wings.begin(), wings.end(), e,
+                                 [](const Wing& w, const std::array<uint32_t, 2>& k) {
+                                   return w.key < k;
+                                 });
+      if (it != wings.end() && it->key == e) {
+        return cells_reason_ = "a facet whose interior segment is another facet's edge", void();
+      }
+    }
+    // A facet edge lying on another facet (not as that facet's own polygon
+    // edge) would split that facet's sides into pieces: not handled. In a
+    // valid PLC such an edge lies inside the other facet's closed region, so
+    // its midpoint does.
+    for (size_t i = 0; i < wings.size();) {
+      size_t j = i;
+      while (j < wings.size() && wings[j].key == wings[i].key) ++j;
+      const Vec3 u = plc_->vertices[wings[i].key[0]], v = plc_->vertices[wings[i].key[1]];
+      const Vec3 mid = (u + v) / 2.0;
+      Box3 q;
+      q.Add(mid);
+      bool on_other = false;
+      facet_grid_->Query(q, [&](uint32_t g) {
+        if (on_other || !present[g]) return;
+        for (size_t k = i; k < j; ++k) {
+          if (wings[k].facet == g) return;
+        }
+        const FacetGeom& gg = facets_[g];
+        if (SideOf(gg.plane, u, tol_) == 0 && SideOf(gg.plane, v, tol_) == 0 &&
+            InFacetRegion(gg, mid)) {
+          on_other = true;
+        }
+      });
+      if (on_other) {
+        return cells_reason_ = absl::StrCat("facet ", wings[i].facet, "'s edge (", wings[i].key[0],
+                                            " ", wings[i].key[1], ") lies inside another facet"),
+               void();
+      }
+      i = j;
+    }
+    std::vector<uint32_t> uf(2 * nf);
+    std::iota(uf.begin(), uf.end(), 0u);
+    auto unite = [&](uint32_t a, uint32_t b) { uf[Find(uf, a)] = Find(uf, b); };
+    auto node = [](uint32_t f, int side) { return 2 * f + (side > 0 ? 0 : 1); };
+    for (size_t i = 0; i < wings.size();) {
+      size_t j = i;
+      while (j < wings.size() && wings[j].key == wings[i].key) ++j;
+      const Vec3 u = plc_->vertices[wings[i].key[0]], v = plc_->vertices[wings[i].key[1]];
+      std::vector<const Wing*> w;
+      for (size_t k = i; k < j; ++k) w.push_back(&wings[k]);
+      i = j;
+      if (w.size() == 1) {  // a free facet edge: both sides meet around it
+        unite(node(w[0]->facet, 1), node(w[0]->facet, -1));
+        continue;
+      }
+      // Angular order around u->v from the first wing r0 (exact): class 0 = r0,
+      // 1 = (0, π), 2 = π, 3 = (π, 2π); within 1 and 3, q after p iff
+      // Orient3d(u, v, p, q) > 0.
+      const Vec3 r0 = w[0]->q;
+      const int axis0 = geom::DominantAxis(Cross(v - u, r0 - u));
+      const int ref2d = geom::Orient2dProjected(u, v, r0, axis0);
+      bool tie = false;
+      auto cls = [&](const Vec3& p) {
+        const int s = geom::Orient3d(u, v, r0, p);
+        if (s > 0) return 1;
+        if (s < 0) return 3;
+        return geom::Orient2dProjected(u, v, p, axis0) == ref2d ? 0 : 2;
+      };
+      std::vector<int> cl(w.size());
+      for (size_t k = 0; k < w.size(); ++k) cl[k] = cls(w[k]->q);
+      std::vector<size_t> order(w.size());
+      std::iota(order.begin(), order.end(), size_t{0});
+      std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        if (cl[a] != cl[b]) return cl[a] < cl[b];
+        if (a == b) return false;
+        const int s = geom::Orient3d(u, v, w[a]->q, w[b]->q);
+        if (s == 0) tie = true;
+        return s > 0 ? true : (s < 0 ? false : a < b);
+      });
+      for (size_t k = 1; k < order.size(); ++k) {
+        if (cl[order[k]] == cl[order[k - 1]] && (cl[order[k]] == 0 || cl[order[k]] == 2)) tie = true;
+      }
+      if (tie) return cells_reason_ = "overlapping facets around an edge", void();
+      // The wedge from wing a to the next wing b (increasing angle) lies on
+      // the side Orient3d(u, v, q_a, .) > 0 of a and < 0 of b.
+      auto facing = [&](const Wing& x, int toward) {
+        const FacetGeom& fg = facets_[x.facet];
+        const Vec3 y = fg.plane.a + fg.plane.n * cell_len_;
+        return toward * facet_sigma_[x.facet] * geom::Orient3d(u, v, x.q, y);
+      };
+      for (size_t k = 0; k < order.size(); ++k) {
+        const Wing& a = *w[order[k]];
+        const Wing& b = *w[order[(k + 1) % order.size()]];
+        const int sa = facing(a, 1), sb = facing(b, -1);
+        if (sa == 0 || sb == 0) return cells_reason_ = "a degenerate wing", void();
+        unite(node(a.facet, sa), node(b.facet, sb));
+      }
+    }
+    // Shells.
+    node_shell_.assign(2 * nf, kNone);
+    for (size_t f = 0; f < nf; ++f) {
+      if (!present[f]) continue;
+      for (uint32_t nd : {node(f, 1), node(f, -1)}) {
+        const uint32_t root = Find(uf, nd);
+        if (node_shell_[root] == kNone) {
+          node_shell_[root] = static_cast<uint32_t>(shell_nodes_.size());
+          shell_nodes_.emplace_back();
+        }
+        node_shell_[nd] = node_shell_[root];
+        shell_nodes_[node_shell_[nd]].push_back(nd);
+      }
+    }
+    constexpr size_t kMaxShells = 256;
+    if (shell_nodes_.size() > kMaxShells) return cells_reason_ = "more than 256 shells", void();
+    const size_t ns = shell_nodes_.size();
+    shell_volume_.assign(ns, 0);
+    shell_cell_of_positive_.assign(ns, -1);
+    for (size_t s = 0; s < ns; ++s) {
+      bool fin_only = true;
+      double vol = 0;
+      for (uint32_t nd : shell_nodes_[s]) {
+        const uint32_t f = nd / 2;
+        const int side = nd % 2 == 0 ? 1 : -1;
+        fin_only = fin_only && node_shell_[nd ^ 1u] == s;
+        const FacetGeom& fg = facets_[f];
+        const Vec3 out = -(side * facet_sigma_[f]) * fg.plane.n;
+        vol += fg.area * Dot(out, fg.plane.a - cell_origin_) / 3.0;
+      }
+      shell_volume_[s] = fin_only ? 0 : vol;
+      if (!fin_only && vol > 0) {
+        shell_cell_of_positive_[s] = num_bounded_cells_++;
+        cell_outer_volume_.push_back(vol);
+      }
+    }
+    cell_volume_ = cell_outer_volume_;
+    cell_volume_.push_back(0);  // the unbounded cell, id num_bounded_cells_
+    node_cell_.assign(2 * nf, -1);
+    for (size_t s = 0; s < ns; ++s) {
+      int32_t cell = shell_cell_of_positive_[s];
+      if (cell < 0) {
+        // An inner shell: the cell on its side of one of its facets.
+        const uint32_t nd = shell_nodes_[s][0];
+        Vec3 x;
+        if (!FacetInteriorPoint(facets_[nd / 2], &x)) {
+          return cells_reason_ = "a facet without an interior point", void();
+        }
+        cell = LocateCell(x, nd / 2);
+        if (cell < 0) return cells_reason_ = "an inner shell touching another shell", void();
+        if (cell < num_bounded_cells_) cell_volume_[cell] += shell_volume_[s];
+      }
+      for (uint32_t nd : shell_nodes_[s]) node_cell_[nd] = cell;
+    }
+    for (int32_t c = 0; c < num_bounded_cells_; ++c) {
+      if (!(cell_volume_[c] > 0)) return cells_reason_ = "a cell of non-positive volume", void();
+    }
+    cell_hole_.assign(num_bounded_cells_ + 1, 0);
+    cell_hole_[num_bounded_cells_] = 1;  // the unbounded cell is never meshed
+    for (const Vec3& h : plc_->holes) {
+      const int32_t c = LocateCell(h);
+      if (c < 0) return cells_reason_ = "a hole seed on a facet", void();
+      cell_hole_[c] = 1;
+    }
+    double total = 0;
+    for (int32_t c = 0; c < num_bounded_cells_; ++c) total += cell_hole_[c] ? 0 : cell_volume_[c];
+    rep_->enclosed_volume = total;
+    rep_->enclosed_volume_known = true;
+    cells_known_ = true;
+  }
+
+  // Region by region (cell by cell): the tets in each cell must fill it
+  // exactly once (meshed cells) or not at all (holes, the unbounded cell).
+  // Tets are grouped into components by flooding across faces shared by two
+  // tets and lying on no facet; a component lies in one cell (no tet crosses
+  // a facet), located by the centroid of one of its tets.
+  // False when some component could not be located (nothing reported).
+  bool CheckCellCoverage() {
+    const size_t nt = mesh_.tets.size();
+    std::vector<uint32_t> uf(nt);
+    std::iota(uf.begin(), uf.end(), 0u);
+    // Vertices on some facet plane (within a facet's box): only faces with
+    // three such vertices can lie on a facet.
+    std::vector<uint8_t> on_plane(mesh_.positions.size(), 0);
+    for (size_t v = 0; v < mesh_.positions.size(); ++v) {
+      Box3 q;
+      q.Add(P(static_cast<uint32_t>(v)));
+      facet_grid_->Query(q, [&](uint32_t f) {
+        if (!on_plane[v] && facets_[f].valid &&
+            SideOf(facets_[f].plane, P(static_cast<uint32_t>(v)), tol_) == 0) {
+          on_plane[v] = 1;
+        }
+      });
+    }
+    for (size_t i = 0; i + 1 < faces_.size();) {
+      size_t j = i;
+      while (j < faces_.size() && faces_[j].SameKey(faces_[i])) ++j;
+      if (j - i == 2) {
+        const auto& k = faces_[i].key;
+        bool on_facet = false;
+        if (on_plane[k[0]] && on_plane[k[1]] && on_plane[k[2]]) {
+          ForFacetsContaining(P(k[0]), P(k[1]), P(k[2]), [&](uint32_t) { on_facet = true; });
+        }
+        if (!on_facet) uf[Find(uf, faces_[i].tet)] = Find(uf, faces_[i + 1].tet);
+      }
+      i = j;
+    }
+    std::vector<int32_t> comp_cell(nt, -1);  // by root
+    std::vector<uint8_t> tries(nt, 0);
+    for (size_t t = 0; t < nt; ++t) {
+      if (!tet_ok_[t]) continue;
+      const uint32_t r = Find(uf, static_cast<uint32_t>(t));
+      const auto& q = mesh_.tets[t];
+      if (comp_cell[r] < 0 && tries[r] < 8) {
+        ++tries[r];
+        comp_cell[r] = LocateCell((P(q[0]) + P(q[1]) + P(q[2]) + P(q[3])) / 4.0);
+      }
+    }
+    std::vector<double> cell_mesh(num_bounded_cells_ + 1, 0);
+    const Vec3 o = mesh_box_.Center();
+    size_t unlocated = 0;
+    for (size_t t = 0; t < nt; ++t) {
+      if (!tet_ok_[t]) continue;
+      const auto& q = mesh_.tets[t];
+      const int32_t c = comp_cell[Find(uf, static_cast<uint32_t>(t))];
+      const Vec3 a = P(q[0]) - o;
+      const double vol = Dot((P(q[1]) - o) - a, Cross((P(q[2]) - o) - a, (P(q[3]) - o) - a)) / 6.0;
+      if (c < 0) {
+        ++unlocated;
+        continue;
+      }
+      cell_mesh[c] += vol;
+    }
+    if (unlocated > 0) {
+      // Only near-degenerate components (every tried centroid within rounding
+      // of a facet) get here; the global volume check still applies.
+      rep_->cells_unknown_reason =
+          absl::StrCat(unlocated, " tets in components that could not be located");
+      return false;
+    }
+    const double scale = std::max(rep_->enclosed_volume, 1e-300);
+    for (int32_t c = 0; c <= num_bounded_cells_; ++c) {
+      const bool meshed = !cell_hole_[c];
+      const double want = meshed ? cell_volume_[c] : 0;
+      if (std::fabs(cell_mesh[c] - want) <= opt_.volume_rel_tol * std::max(want, scale)) continue;
+      std::string seeds;
+      for (size_t r = 0; r < plc_->regions.size(); ++r) {
+        if (LocateCell(plc_->regions[r].point) == c) absl::StrAppend(&seeds, " ", r);
+      }
+      const std::string what =
+          c == num_bounded_cells_ ? std::string("the unbounded cell")
+                                  : absl::StrCat("cell ", c, cell_hole_[c] ? " (a volume hole)" : "",
+                                                 seeds.empty() ? "" : " with region seed(s)" + seeds);
+      Add(rep_, opt_, ViolationKind::kVolumeMismatch, {c},
+          absl::StrFormat("%s: tets in it have volume %.17g, expected %.17g (%s)", what,
+                          cell_mesh[c], want,
+                          cell_mesh[c] > want ? "covered more than once or outside the domain"
+                                              : "not filled"));
+    }
+    return true;
+  }
+
   void CheckInputVertices() {
     const size_t nv = mesh_.positions.size();
     std::vector<uint32_t> order(nv);
@@ -930,7 +1375,11 @@ class Checker {
       if (!facets_[f].valid) continue;
       // A facet no tet touches lies outside the meshed domain (e.g. between a
       // volume hole and the exterior): TetGen and we drop it.
-      if (covered[f] == 0 && !facet_crossed_[f] && !AnyTetFaceOn(f)) {
+      const bool outside =
+          cells_known_ ? node_cell_[2 * f] >= 0 && cell_hole_[node_cell_[2 * f]] &&
+                             node_cell_[2 * f + 1] >= 0 && cell_hole_[node_cell_[2 * f + 1]]
+                       : covered[f] == 0 && !facet_crossed_[f] && !AnyTetFaceOn(f);
+      if (outside) {
         ++rep_->num_facets_outside;
         continue;
       }
@@ -1067,6 +1516,20 @@ class Checker {
   uint32_t query_ = 0;
   std::vector<uint32_t> input_map_;
   std::vector<uint32_t> adj_start_, adj_;
+  // Cells of the facet arrangement (BuildCells).
+  bool cells_known_ = false;
+  std::string cells_reason_;
+  Vec3 cell_origin_;
+  double cell_len_ = 1;
+  std::vector<int> facet_sigma_;
+  std::vector<uint32_t> node_shell_;
+  std::vector<std::vector<uint32_t>> shell_nodes_;
+  std::vector<double> shell_volume_;
+  std::vector<int32_t> shell_cell_of_positive_;
+  int32_t num_bounded_cells_ = 0;
+  std::vector<double> cell_outer_volume_, cell_volume_;
+  std::vector<int32_t> node_cell_;
+  std::vector<uint8_t> cell_hole_;
 };
 
 }  // namespace

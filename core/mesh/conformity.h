@@ -77,6 +77,11 @@ struct ConformityReport {
   double mesh_volume = 0;
   double enclosed_volume = 0;
   bool enclosed_volume_known = false;  // see docs/conformity.md for when
+  // The cells of the facet arrangement were built (docs/conformity.md): the
+  // enclosed volume comes from them and every cell's coverage is checked.
+  bool cells_known = false;
+  size_t num_cells = 0;               // bounded cells (holes included)
+  std::string cells_unknown_reason;   // when !cells_known
   size_t num_segments_checked = 0;
   size_t num_facets_checked = 0;   // valid (planar, non-degenerate) facets
   size_t num_facets_outside = 0;   // of those, touched by no tet: outside the domain

@@ -45,8 +45,12 @@ TEST(Conformity, AcceptsInternalFacetAndFarOffset) {
   const plc::Plc split = BoxPlc(kLo, kHi, /*split=*/true);
   const ConformityReport r = CheckConformity(split, KuhnBoxMesh(split, 2));
   EXPECT_TRUE(r.ok()) << r.Summary();
-  // Internal facets make the facet complex non-manifold: volume unknown.
+  // BoxPlc's internal facet ends inside the box's side facets (their sides
+  // would split into pieces): cells and volume unknown (docs/conformity.md).
+  EXPECT_FALSE(r.cells_known);
   EXPECT_FALSE(r.enclosed_volume_known);
+  EXPECT_NE(r.cells_unknown_reason.find("lies inside another facet"), std::string::npos)
+      << r.cells_unknown_reason;
   const plc::Plc far = BoxPlc(Vec3(1e6, 1e6, 1e6), Vec3(1e6 + 1000, 1e6 + 1000, 1e6 + 1000));
   const ConformityReport r2 = CheckConformity(far, KuhnBoxMesh(far, 4));
   EXPECT_TRUE(r2.ok()) << r2.Summary();
@@ -77,7 +81,12 @@ TEST(Conformity, KeepBoundingBox) {
   // Without the flag the box faces are open faces.
   const ConformityReport r2 = CheckConformity(p, m);
   EXPECT_GT(r2.Count(ViolationKind::kOpenFace), 0u);
-  EXPECT_EQ(r2.Count(ConformityCategory::kCoverage), r2.Count(ViolationKind::kOpenFace));
+  // ... and a lone facet encloses nothing: every tet is in the unbounded cell.
+  EXPECT_TRUE(r2.cells_known) << r2.cells_unknown_reason;
+  EXPECT_EQ(r2.num_cells, 0u);
+  EXPECT_EQ(r2.Count(ViolationKind::kVolumeMismatch), 1u) << r2.Summary();
+  EXPECT_EQ(r2.Count(ConformityCategory::kCoverage),
+            r2.Count(ViolationKind::kOpenFace) + r2.Count(ViolationKind::kVolumeMismatch));
 }
 
 // The corner tetrahedron o,a,b,c with Steiner points that doubles cannot put
@@ -389,6 +398,99 @@ TEST(Conformity, NestedShellsAndVolumeHoles) {
   const ConformityReport rm = CheckConformity(no_seed, holed.mesh);
   EXPECT_EQ(rm.Count(ViolationKind::kVolumeMismatch), 1u) << rm.Summary();
   EXPECT_EQ(rm.violations.size(), 1u) << rm.Summary();
+}
+
+// The split box with the four side facets cut along the internal facet's
+// edges (as in the corpus's box_internal_facet.poly): two cells, x < 1/2
+// (region seed 0) and x > 1/2 (region seed 1).
+struct SplitBox {
+  plc::Plc plc;
+  TetMesh mesh;
+};
+SplitBox ProperSplitBox(int n) {
+  SplitBox b;
+  b.plc = BoxPlc(kLo, kHi, /*split=*/true);
+  b.mesh = KuhnBoxMesh(b.plc, n);
+  auto quad = [&](std::vector<uint32_t> v, int32_t marker) {
+    plc::Facet f;
+    f.polygons.push_back({std::move(v)});
+    f.marker = marker;
+    return f;
+  };
+  // Corners: i + 2j + 4k; 8..11 = (½,0,0), (½,1,0), (½,1,1), (½,0,1).
+  b.plc.facets = {quad({0, 2, 6, 4}, 1),   quad({1, 3, 7, 5}, 2),   quad({8, 9, 10, 11}, 7),
+                  quad({0, 8, 11, 4}, 3),  quad({8, 1, 5, 11}, 3),  quad({2, 9, 10, 6}, 4),
+                  quad({9, 3, 7, 10}, 4),  quad({0, 8, 9, 2}, 5),   quad({8, 1, 3, 9}, 5),
+                  quad({4, 11, 10, 6}, 6), quad({11, 5, 7, 10}, 6)};
+  b.plc.regions = {{Vec3(0.25, 0.5, 0.5), 1, 0}, {Vec3(0.75, 0.5, 0.5), 2, 0}};
+  testing::AssignAxisAlignedTriangles(b.plc, &b.mesh);
+  return b;
+}
+
+// Keeps the tets whose centroid satisfies keep(centroid).
+template <typename F>
+void FilterTets(TetMesh* m, F keep) {
+  std::vector<std::array<uint32_t, 4>> tets;
+  for (const auto& t : m->tets) {
+    const Vec3 c = (m->positions[t[0]] + m->positions[t[1]] + m->positions[t[2]] +
+                    m->positions[t[3]]) / 4.0;
+    if (keep(c)) tets.push_back(t);
+  }
+  m->tets = tets;
+  m->tet_region.assign(tets.size(), 0);
+}
+
+TEST(Conformity, InternalFacetCellsRegionByRegion) {
+  const SplitBox b = ProperSplitBox(4);
+  const ConformityReport r = CheckConformity(b.plc, b.mesh);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  ASSERT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_EQ(r.num_cells, 2u);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
+  EXPECT_EQ(r.num_facets_outside, 0u);
+
+  // A whole region deleted (every tet with x < ½): its faces on the internal
+  // facet become boundary faces, which lie on a facet, so only the cell's
+  // coverage shows it.
+  SplitBox missing = b;
+  FilterTets(&missing.mesh, [](const Vec3& c) { return c.x > 0.5; });
+  testing::AssignAxisAlignedTriangles(missing.plc, &missing.mesh);
+  const ConformityReport rm = CheckConformity(missing.plc, missing.mesh);
+  EXPECT_EQ(rm.Count(ViolationKind::kVolumeMismatch), 1u) << rm.Summary();
+  EXPECT_EQ(rm.Count(ViolationKind::kOpenFace), 0u) << rm.Summary();
+  ASSERT_FALSE(rm.violations.empty());
+  bool named = false;
+  for (const Violation& v : rm.violations) {
+    if (v.kind == ViolationKind::kVolumeMismatch) {
+      named = v.message.find("region seed(s) 0") != std::string::npos &&
+              v.message.find("not filled") != std::string::npos;
+    }
+  }
+  EXPECT_TRUE(named) << rm.Summary();
+
+  // A region meshed twice (the x > ½ tets duplicated with shifted ids into a
+  // copy of their vertices): the copy is a separate component in the same cell.
+  SplitBox twice = b;
+  const uint32_t nv = static_cast<uint32_t>(twice.mesh.positions.size());
+  twice.mesh.positions.insert(twice.mesh.positions.end(), b.mesh.positions.begin(),
+                              b.mesh.positions.end());
+  for (const auto& t : b.mesh.tets) {
+    const Vec3 c = (b.mesh.positions[t[0]] + b.mesh.positions[t[1]] + b.mesh.positions[t[2]] +
+                    b.mesh.positions[t[3]]) / 4.0;
+    if (c.x > 0.5) twice.mesh.tets.push_back({t[0] + nv, t[1] + nv, t[2] + nv, t[3] + nv});
+  }
+  twice.mesh.tet_region.assign(twice.mesh.tets.size(), 0);
+  ConformityOptions opt;
+  opt.input_vertices_first = false;  // the copies of input vertices come later
+  const ConformityReport rt = CheckConformity(twice.plc, twice.mesh, opt);
+  EXPECT_EQ(rt.Count(ViolationKind::kVolumeMismatch), 1u) << rt.Summary();
+  bool more = false;
+  for (const Violation& v : rt.violations) {
+    more = more || (v.kind == ViolationKind::kVolumeMismatch &&
+                    v.message.find("region seed(s) 1") != std::string::npos &&
+                    v.message.find("more than once") != std::string::npos);
+  }
+  EXPECT_TRUE(more) << rt.Summary();
 }
 
 TEST(Conformity, ScalesToHundredsOfThousandsOfTets) {

@@ -3,6 +3,7 @@
 // meshes, broken on purpose, must fail in the right category.
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include "absl/strings/str_cat.h"
@@ -68,14 +69,13 @@ TEST_P(TetgenCorpus, CheckerAcceptsTetgenMesh) {
   // example.poly: facet #20 separates a volume hole from the exterior; every
   // other facet of these inputs bounds the domain.
   EXPECT_EQ(r.num_facets_outside, c.file == "b_internal/example.poly" ? 1u : 0u);
-  // Internal facets make the facet complex non-manifold: volume unknown
-  // there (docs/conformity.md); every other input's volume is checked.
-  const bool internal_facets =
-      c.file == "b_internal/box_internal_facet.poly" || c.file == "b_internal/example.poly";
-  EXPECT_EQ(r.enclosed_volume_known, !internal_facets);
-  if (r.enclosed_volume_known) {
-    EXPECT_NEAR(r.mesh_volume, r.enclosed_volume, 1e-9 * r.enclosed_volume);
-  }
+  // Every input's cells are built (internal facets included) and each
+  // cell's coverage is checked (docs/conformity.md).
+  EXPECT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_TRUE(r.enclosed_volume_known);
+  EXPECT_NEAR(r.mesh_volume, r.enclosed_volume, 1e-9 * r.enclosed_volume);
+  if (c.file == "b_internal/box_internal_facet.poly") EXPECT_EQ(r.num_cells, 2u);
+  if (c.file == "b_internal/box_in_box.poly") EXPECT_EQ(r.num_cells, 2u);
   std::printf("%s -%s: %zu vertices, %zu tets, %zu triangles, volume %.17g (enclosed %s)\n",
               c.file.c_str(), c.switches.c_str(), mesh->positions.size(), mesh->tets.size(),
               mesh->triangles.size(), r.mesh_volume,
@@ -154,6 +154,88 @@ TEST_F(TetgenMutations, VertexMovedOffItsFacet) {
   mesh_.positions[v] = mesh_.positions[v] + Vec3(1e-6, 1e-6, 1e-6);
   const ConformityReport r = CheckConformity(plc_, mesh_, opt_);
   EXPECT_GT(r.Count(ConformityCategory::kConformity), 0u) << r.Summary();
+}
+
+// tetgen's mesh of box_internal_facet.poly (two regions split by z = ½), with
+// a whole region deleted or meshed twice.
+class TetgenRegions : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto p = plc::ReadPlcFile(svrc::testing::CorpusPath("b_internal/box_internal_facet.poly"));
+    ASSERT_TRUE(p.ok()) << p.status();
+    plc_ = *p;
+    const std::string node = RunTetgen("b_internal/box_internal_facet.poly", "pq2AQ");
+    ASSERT_FALSE(node.empty());
+    auto m = ReadTetgenMesh(node);
+    ASSERT_TRUE(m.ok()) << m.status();
+    mesh_ = *m;
+    opt_.input_vertices_first = false;
+    const ConformityReport r = CheckConformity(plc_, mesh_, opt_);
+    ASSERT_TRUE(r.ok()) << r.Summary();
+    ASSERT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  }
+  static double CentroidZ(const TetMesh& m, const std::array<uint32_t, 4>& t) {
+    return (m.positions[t[0]].z + m.positions[t[1]].z + m.positions[t[2]].z +
+            m.positions[t[3]].z) / 4;
+  }
+  plc::Plc plc_;
+  TetMesh mesh_;
+  ConformityOptions opt_;
+};
+
+TEST_F(TetgenRegions, DeletedRegionIsRejected) {
+  TetMesh m = mesh_;
+  m.tets.clear();
+  m.tet_region.clear();
+  for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+    if (CentroidZ(mesh_, mesh_.tets[t]) > 0.5) {
+      m.tets.push_back(mesh_.tets[t]);
+      m.tet_region.push_back(mesh_.tet_region[t]);
+    }
+  }
+  ASSERT_LT(m.tets.size(), mesh_.tets.size());
+  // Keep only the triangles that are still faces (the bottom region's
+  // boundary triangles go with it), so that only the coverage can tell.
+  std::set<std::array<uint32_t, 3>> faces;
+  for (const auto& t : m.tets) {
+    for (int k = 0; k < 4; ++k) {
+      std::array<uint32_t, 3> f = {t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
+      std::sort(f.begin(), f.end());
+      faces.insert(f);
+    }
+  }
+  m.triangles.clear();
+  m.triangle_marker.clear();
+  for (size_t i = 0; i < mesh_.triangles.size(); ++i) {
+    auto f = mesh_.triangles[i];
+    std::sort(f.begin(), f.end());
+    if (faces.count(f)) {
+      m.triangles.push_back(mesh_.triangles[i]);
+      m.triangle_marker.push_back(mesh_.triangle_marker[i]);
+    }
+  }
+  const ConformityReport r = CheckConformity(plc_, m, opt_);
+  EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 1u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kOpenFace), 0u) << r.Summary();
+  EXPECT_NE(r.Summary().find("region seed(s) 0"), std::string::npos) << r.Summary();
+  EXPECT_NE(r.Summary().find("not filled"), std::string::npos) << r.Summary();
+}
+
+TEST_F(TetgenRegions, DuplicatedRegionIsRejected) {
+  TetMesh m = mesh_;
+  const uint32_t nv = static_cast<uint32_t>(m.positions.size());
+  m.positions.insert(m.positions.end(), mesh_.positions.begin(), mesh_.positions.end());
+  for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+    if (CentroidZ(mesh_, mesh_.tets[t]) > 0.5) {
+      const auto& q = mesh_.tets[t];
+      m.tets.push_back({q[0] + nv, q[1] + nv, q[2] + nv, q[3] + nv});
+      m.tet_region.push_back(mesh_.tet_region[t]);
+    }
+  }
+  const ConformityReport r = CheckConformity(plc_, m, opt_);
+  EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 1u) << r.Summary();
+  EXPECT_NE(r.Summary().find("region seed(s) 1"), std::string::npos) << r.Summary();
+  EXPECT_NE(r.Summary().find("more than once"), std::string::npos) << r.Summary();
 }
 
 }  // namespace
