@@ -327,6 +327,7 @@ const char* PredicateName(Pred p) {
     case Pred::kCompareDistance: return "compare_distance";
     case Pred::kDotSign: return "dot_sign";
     case Pred::kOrient2dProjected: return "orient2d_projected";
+    case Pred::kInBall: return "in_ball";
     case Pred::kCount: break;
   }
   return "?";
@@ -578,6 +579,17 @@ int DotSign(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return Decide(Pred::kDotSign, 2, {a, b, c, d}, [](auto* tag, const Vec3* q) {
     using T = std::remove_pointer_t<decltype(tag)>;
     return DotSignPoly<T>(q[0], q[1], q[2], q[3]);
+  });
+}
+
+int InBall(const Vec3& p, const Vec3& c, double r) {
+  // r rides as the x coordinate of a third point so that the exact path's
+  // common scaling applies to it too (the expression is homogeneous of degree 2).
+  return Decide(Pred::kInBall, 2, {p, c, Vec3(r, 0, 0)}, [](auto* tag, const Vec3* q) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const V3<T> pc = Sub<T>(q[0], q[1]);
+    const T rr = CvX<T>(q[2].x);
+    return T(rr * rr - DotT(pc, pc));  // T(): no mpq expression template over locals
   });
 }
 

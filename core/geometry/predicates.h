@@ -77,6 +77,7 @@ enum class Pred : int {
   kCompareDistance,
   kDotSign,
   kOrient2dProjected,
+  kInBall,
   kCount
 };
 inline constexpr int kNumPredicates = static_cast<int>(Pred::kCount);
@@ -347,6 +348,9 @@ int CompareDistance(const Vec3& p, const Vec3& a, const Vec3& b);
 int CompareDistance(Vec2 p, Vec2 a, Vec2 b);
 int DotSign(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 int Orient2dProjected(const Vec3& a, const Vec3& b, const Vec3& c, int axis);
+// sign(r² − |p − c|²): >0 iff p is strictly inside the ball B(c, r) whose radius r
+// is a given double (collar balls, thesis §2.4); 0 on its sphere.
+int InBall(const Vec3& p, const Vec3& c, double r);
 
 // Index (0, 1, 2) of the largest |component| of n (ties: the lowest index).
 inline int DominantAxis(const Vec3& n) {
