@@ -1,0 +1,243 @@
+// Facet meshes M_F (thesis §3.1, Definition 35; guide §5 item 4).
+#include "core/svrc/facet_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/geometry/predicates.h"
+
+namespace svrc::refine {
+
+using geom::Vec2;
+using Delaunay2 = delaunay::Delaunay2;
+
+namespace {
+
+// Ω_F's corners: centre of the uv box ± 1.5·diam (side 3·diam(F)).
+std::pair<Vec2, Vec2> SquareOf(const FacetRegion& r) {
+  const Vec2 c = 0.5 * (r.lo + r.hi);
+  const Vec2 d = r.hi - r.lo;
+  double half = 1.5 * std::sqrt(geom::Norm2(d));
+  if (!(half > 0)) half = 1.0;  // a degenerate facet cannot pass validation; stay finite
+  return {Vec2{c.x - half, c.y - half}, Vec2{c.x + half, c.y + half}};
+}
+
+double Dist2(Vec2 a, Vec2 b) { return geom::Norm2(a - b); }
+
+}  // namespace
+
+void FacetRegion::AddLoop(std::vector<Vec2> uv, std::vector<PointId> points, bool is_hole) {
+  Loop l;
+  double area = 0;
+  const size_t n = uv.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Vec2 a = uv[i], b = uv[(i + 1) % n];
+    area += a.x * b.y - a.y * b.x;
+    if (loops.empty() && i == 0 && lo.x == 0 && hi.x == 0 && lo.y == 0 && hi.y == 0) {
+      lo = hi = a;
+    }
+    lo = {std::fmin(lo.x, a.x), std::fmin(lo.y, a.y)};
+    hi = {std::fmax(hi.x, a.x), std::fmax(hi.y, a.y)};
+  }
+  l.uv = std::move(uv);
+  l.points = std::move(points);
+  l.is_hole = is_hole;
+  l.abs_area = 0.5 * std::fabs(area);
+  loops.push_back(std::move(l));
+}
+
+FacetRegion::Where FacetRegion::Locate(Vec2 p) const {
+  // Crossing number along the ray from p towards +x, half-open in y; each
+  // "edge right of p" decision is an exact Orient2d sign.
+  const Loop* innermost = nullptr;
+  for (const Loop& l : loops) {
+    const size_t n = l.uv.size();
+    bool inside = false;
+    for (size_t i = 0; i < n; ++i) {
+      const Vec2 a = l.uv[i], b = l.uv[(i + 1) % n];
+      const int o = geom::Orient2d(a, b, p);
+      if (o == 0 && std::fmin(a.x, b.x) <= p.x && p.x <= std::fmax(a.x, b.x) &&
+          std::fmin(a.y, b.y) <= p.y && p.y <= std::fmax(a.y, b.y)) {
+        return Where::kOnBoundary;
+      }
+      if ((a.y > p.y) != (b.y > p.y)) {
+        // Upward edge (b above): crosses the ray iff p is left of a→b.
+        if (b.y > a.y ? o > 0 : o < 0) inside = !inside;
+      }
+    }
+    if (inside && (innermost == nullptr || l.abs_area < innermost->abs_area)) innermost = &l;
+  }
+  if (innermost == nullptr || innermost->is_hole) return Where::kOutside;
+  return Where::kInside;
+}
+
+bool FacetRegion::CrossesSegment(Vec2 a, Vec2 b, Vec2 c) const {
+  const std::array<Vec2, 3> t = {a, b, c};
+  for (const auto& s : segments) {
+    bool separated = false;
+    // Triangle edge lines (abc counter-clockwise: interior is left, > 0).
+    for (int e = 0; e < 3 && !separated; ++e) {
+      const Vec2 u = t[e], w = t[(e + 1) % 3];
+      separated = geom::Orient2d(u, w, s[0]) <= 0 && geom::Orient2d(u, w, s[1]) <= 0;
+    }
+    if (separated) continue;
+    // The segment's line: the open triangle is on one side iff all three
+    // vertices are on one closed side (not all zero: abc is not degenerate).
+    int pos = 0, neg = 0;
+    for (const Vec2& x : t) {
+      const int o = geom::Orient2d(s[0], s[1], x);
+      pos += o > 0;
+      neg += o < 0;
+    }
+    if (pos == 0 || neg == 0) continue;
+    return true;
+  }
+  return false;
+}
+
+bool FacetRegion::TriangleInFacet(Vec2 a, Vec2 b, Vec2 c) const {
+  const Vec2 centroid{(a.x + b.x + c.x) / 3.0, (a.y + b.y + c.y) / 3.0};
+  if (Locate(centroid) == Where::kInside) return true;
+  return CrossesSegment(a, b, c);
+}
+
+FacetRegion BuildFacetRegion(const plc::FeatureComplex& complex, uint32_t facet,
+                             const Normalization& norm, std::span<const PointId> point_ids,
+                             plc::FacetFrame* normalised_frame) {
+  const plc::FeatureFacet& f = complex.facets[facet];
+  plc::FacetFrame frame = f.frame;
+  frame.origin = norm.Forward(f.frame.origin);
+  // The same point always gets the same uv (projected once per facet).
+  auto uv_of = [&](plc::PointId p) { return frame.ToPlane(norm.Forward(complex.points[p].p)); };
+  FacetRegion r;
+  for (size_t i = 0; i < f.loops.size(); ++i) {
+    std::vector<Vec2> uv;
+    std::vector<PointId> ids;
+    for (plc::PointId p : f.loops[i]) {
+      uv.push_back(uv_of(p));
+      ids.push_back(point_ids[p]);
+    }
+    r.AddLoop(std::move(uv), std::move(ids), f.loop_is_hole[i]);
+  }
+  for (plc::SegmentId s : f.segments) {
+    const plc::FeatureSegment& seg = complex.segments[s];
+    r.segments.push_back({uv_of(seg.a), uv_of(seg.b)});
+    r.segment_points.push_back({point_ids[seg.a], point_ids[seg.b]});
+  }
+  for (plc::PointId p : f.interior_points) {
+    r.interior_uv.push_back(uv_of(p));
+    r.interior_points.push_back(point_ids[p]);
+  }
+  if (normalised_frame != nullptr) *normalised_frame = frame;
+  return r;
+}
+
+FacetMesh::FacetMesh(FacetRegion region, const std::array<PointId, 4>& corner_ids)
+    : region_(std::move(region)),
+      square_lo_(SquareOf(region_).first),
+      square_hi_(SquareOf(region_).second),
+      dt_(Delaunay2::Square(square_lo_, square_hi_,
+                            {corner_ids[0].value(), corner_ids[1].value(), corner_ids[2].value(),
+                             corner_ids[3].value()})) {
+  for (uint32_t i = 0; i < 4; ++i) Register(Delaunay2::VertexId(i), corner_ids[i]);
+}
+
+Vec2 FacetMesh::Corner(int i) const {
+  switch (i & 3) {
+    case 0: return square_lo_;
+    case 1: return {square_hi_.x, square_lo_.y};
+    case 2: return square_hi_;
+    default: return {square_lo_.x, square_hi_.y};
+  }
+}
+
+void FacetMesh::Register(VertexId2 v, PointId p) {
+  if (point_of_.size() <= v.value()) {
+    point_of_.resize(v.value() + 1);
+    cell_gen_.resize(v.value() + 1, 0);
+    skinny_event_.resize(v.value() + 1);
+    unresolved_event_.resize(v.value() + 1);
+  }
+  point_of_[v.value()] = p;
+  ++cell_gen_[v.value()];
+}
+
+Delaunay2::InsertResult FacetMesh::Insert(Vec2 uv, PointId id, TriId2 hint) {
+  Delaunay2::InsertResult r = dt_.Insert(uv, id.value(), hint);
+  if (r.outcome == Delaunay2::InsertOutcome::kInserted) {
+    Register(r.vertex, id);
+    for (VertexId2 u : r.cavity_vertices) BumpCell(u);
+  }
+  return r;
+}
+
+bool FacetMesh::InFacet(TriId2 t) const {
+  return region_.TriangleInFacet(dt_.Point(dt_.TriVertex(t, 0)), dt_.Point(dt_.TriVertex(t, 1)),
+                                 dt_.Point(dt_.TriVertex(t, 2)));
+}
+
+std::vector<std::array<PointId, 3>> FacetMesh::InFacetTriangles() const {
+  std::vector<std::array<PointId, 3>> out;
+  for (TriId2 t : dt_.Triangles()) {
+    if (!InFacet(t)) continue;
+    out.push_back({PointOf(dt_.TriVertex(t, 0)), PointOf(dt_.TriVertex(t, 1)),
+                   PointOf(dt_.TriVertex(t, 2))});
+  }
+  return out;
+}
+
+CellSize2 FacetMesh::Size(VertexId2 v) const {
+  CellSize2 out;
+  const Vec2 pv = dt_.Point(v);
+  out.inradius = dt_.InRadius(v);
+  dt_.Star(v, &star_);
+  poly_.clear();
+  bool outside = dt_.IsCorner(v);  // a corner's cell is unbounded
+  if (!outside) {
+    for (TriId2 t : star_) {
+      const Vec2 c = dt_.Circumcenter(t);
+      outside = outside || c.x < square_lo_.x || c.y < square_lo_.y || c.x > square_hi_.x ||
+                c.y > square_hi_.y;
+      poly_.push_back(c);
+    }
+  }
+  if (outside) {
+    // V(v) ∩ Ω_F directly: the square clipped by the bisector half-plane of
+    // every Delaunay neighbour (the Delaunay neighbours' bisectors bound V(v)).
+    // Robust for unbounded cells and circumcentres beyond a side alike.
+    poly_.assign({square_lo_, Vec2{square_hi_.x, square_lo_.y}, square_hi_,
+                  Vec2{square_lo_.x, square_hi_.y}});
+    std::vector<VertexId2>& nbrs = nbrs_;
+    dt_.Neighbors(v, &nbrs);
+    for (VertexId2 u : nbrs) {
+      if (poly_.empty()) break;
+      const Vec2 pu = dt_.Point(u);
+      const Vec2 m = 0.5 * (pv + pu), d = pu - pv;
+      auto f = [&](Vec2 x) { return geom::Dot(x - m, d); };  // ≤ 0: closer to v
+      scratch_.clear();
+      const size_t n = poly_.size();
+      for (size_t i = 0; i < n; ++i) {
+        const Vec2 a = poly_[i], b = poly_[(i + 1) % n];
+        const double fa = f(a), fb = f(b);
+        if (fa <= 0) scratch_.push_back(a);
+        if ((fa <= 0) != (fb <= 0)) scratch_.push_back(a + (fa / (fa - fb)) * (b - a));
+      }
+      poly_.swap(scratch_);
+    }
+    out.clipped = true;
+  }
+  double best = -1;
+  for (const Vec2& c : poly_) {
+    const double d2 = Dist2(c, pv);
+    if (d2 > best) {
+      best = d2;
+      out.corner = c;
+    }
+  }
+  out.outradius = best > 0 ? std::sqrt(best) : 0;
+  out.hint = star_.front();
+  return out;
+}
+
+}  // namespace svrc::refine
