@@ -187,6 +187,51 @@ std::vector<std::array<PointId, 3>> FacetMesh::InFacetTriangles() const {
   return out;
 }
 
+void FacetMesh::TriangleBall(TriId2 t, const plc::FacetFrame& frame, geom::Vec3* center,
+                             double* radius) const {
+  *center = frame.ToSpace(dt_.Circumcenter(t));
+  *radius = dt_.Circumradius(t);
+}
+
+void FacetMesh::SyncTriangleBalls(const Delaunay2::InsertResult& r, const plc::FacetFrame& frame,
+                                  FeatureId feature, MeshId mesh, BallStore* balls,
+                                  std::vector<BallId>* added) {
+  if (r.outcome != Delaunay2::InsertOutcome::kInserted) return;
+  // Destroyed first: slots are reused, so a slot can be in both lists.
+  for (TriId2 t : r.destroyed) {
+    if (t.value() < tri_ball_.size() && tri_ball_[t.value()].valid()) {
+      balls->Kill(tri_ball_[t.value()]);
+      tri_ball_[t.value()] = kNoneBall;
+    }
+  }
+  if (tri_ball_.size() < dt_.TriCapacity()) tri_ball_.resize(dt_.TriCapacity(), kNoneBall);
+  for (TriId2 t : r.created) {
+    if (!InFacet(t)) continue;
+    geom::Vec3 c;
+    double rad;
+    TriangleBall(t, frame, &c, &rad);
+    const BallId b = balls->AddTriangleBall(PointOf(dt_.TriVertex(t, 0)), PointOf(dt_.TriVertex(t, 1)),
+                                            PointOf(dt_.TriVertex(t, 2)), c, rad, feature, mesh);
+    tri_ball_[t.value()] = b;
+    if (added != nullptr) added->push_back(b);
+  }
+}
+
+void FacetMesh::CreateAllTriangleBalls(const plc::FacetFrame& frame, FeatureId feature,
+                                       MeshId mesh, BallStore* balls, std::vector<BallId>* added) {
+  if (tri_ball_.size() < dt_.TriCapacity()) tri_ball_.resize(dt_.TriCapacity(), kNoneBall);
+  for (TriId2 t : dt_.Triangles()) {
+    if (tri_ball_[t.value()].valid() || !InFacet(t)) continue;
+    geom::Vec3 c;
+    double rad;
+    TriangleBall(t, frame, &c, &rad);
+    const BallId b = balls->AddTriangleBall(PointOf(dt_.TriVertex(t, 0)), PointOf(dt_.TriVertex(t, 1)),
+                                            PointOf(dt_.TriVertex(t, 2)), c, rad, feature, mesh);
+    tri_ball_[t.value()] = b;
+    if (added != nullptr) added->push_back(b);
+  }
+}
+
 CellSize2 FacetMesh::Size(VertexId2 v) const {
   CellSize2 out;
   const Vec2 pv = dt_.Point(v);

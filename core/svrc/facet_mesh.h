@@ -12,6 +12,7 @@
 #include "core/delaunay/delaunay2.h"
 #include "core/geometry/vec3.h"
 #include "core/plc/features.h"
+#include "core/svrc/balls.h"
 #include "core/svrc/ids.h"
 #include "core/svrc/normalize.h"
 #include "core/svrc/work_queue.h"
@@ -113,6 +114,29 @@ class FacetMesh {
   // incident to v (the corner is in the conflict region of one of them).
   CellSize2 Size(VertexId2 v) const;
 
+  // --- triangle ConfBalls (thesis §3.2.2; stage (c) increment 2) ----------
+  // The diametral ball of triangle t in 3D: centre = the uv circumcentre
+  // mapped through `frame` (rounded once), radius = the uv circumradius
+  // (design §2: M_F decides in uv; M_Ω tests encroachment on xyz with
+  // InTriangleCircumball3d).
+  void TriangleBall(TriId2 t, const plc::FacetFrame& frame, geom::Vec3* center,
+                    double* radius) const;
+  // Keeps one ConfBall per live in-facet triangle: kills the balls of the
+  // triangles `r` destroyed, adds balls for the in-facet triangles it created
+  // (in-facet status is fixed per triangle: it depends only on its vertices).
+  // `added` (optional) receives the new balls, for linking into M_Ω. Call once
+  // per Insert, with its result, before the next Insert.
+  void SyncTriangleBalls(const Delaunay2::InsertResult& r, const plc::FacetFrame& frame,
+                         FeatureId feature, MeshId mesh, BallStore* balls,
+                         std::vector<BallId>* added = nullptr);
+  // All live in-facet triangles get balls (after the initial inserts).
+  void CreateAllTriangleBalls(const plc::FacetFrame& frame, FeatureId feature, MeshId mesh,
+                              BallStore* balls, std::vector<BallId>* added = nullptr);
+  // The ball of live triangle t (kNoneBall if t is not in F).
+  BallId TriBall(TriId2 t) const {
+    return t.value() < tri_ball_.size() ? tri_ball_[t.value()] : kNoneBall;
+  }
+
   void BumpCell(VertexId2 v) { ++cell_gen_[v.value()]; }
   uint32_t CellGeneration(VertexId2 v) const { return cell_gen_[v.value()]; }
   EventHandle& SkinnyEvent(VertexId2 v) { return skinny_event_[v.value()]; }
@@ -127,6 +151,7 @@ class FacetMesh {
   std::vector<PointId> point_of_;
   std::vector<uint32_t> cell_gen_;
   std::vector<EventHandle> skinny_event_, unresolved_event_;
+  std::vector<BallId> tri_ball_;  // by triangle slot; kNoneBall: none
   mutable std::vector<Delaunay2::TriId> star_;
   mutable std::vector<VertexId2> nbrs_;
   mutable std::vector<geom::Vec2> poly_, scratch_;

@@ -102,21 +102,59 @@ TEST(FacetRegionTest, StraddlingTrianglesAreInFacet) {
 
 // Inserts every point of the region into M_F; checks Delaunay validity and
 // that in-facet triangles cover F (exactly when F's segments are M_F edges).
+// Checks that exactly the live in-facet triangles own a live ConfBall, whose
+// dual triangle is theirs and whose centre is equidistant (radius) from the
+// triangle's vertices mapped to 3D through the frame.
+void CheckTriangleBalls(const FacetMesh& mesh, const BallStore& balls,
+                        const plc::FacetFrame& frame) {
+  const auto& dt = mesh.dt();
+  uint32_t in_facet = 0;
+  for (auto t : dt.Triangles()) {
+    const BallId b = mesh.TriBall(t);
+    ASSERT_EQ(b.valid(), mesh.InFacet(t));
+    if (!b.valid()) continue;
+    ++in_facet;
+    ASSERT_TRUE(balls.IsAlive(b));
+    ASSERT_EQ(balls.NumVertices(b), 3);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(balls.Vertex(b, i), mesh.PointOf(dt.TriVertex(t, i)));
+      const Vec3 x = frame.ToSpace(dt.Point(dt.TriVertex(t, i)));
+      EXPECT_NEAR(geom::Dist(x, balls.Center(b)), balls.Radius(b), 1e-12 * (1 + balls.Radius(b)));
+    }
+    EXPECT_NEAR(geom::Dot(balls.Center(b) - frame.origin, frame.normal), 0,
+                1e-14 * (1 + balls.Radius(b)));
+  }
+  EXPECT_EQ(balls.NumAlive(), in_facet);
+}
+
 // Returns whether F's segments were all M_F edges (the exact-area case).
-bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double facet_area) {
+bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double facet_area,
+                    const plc::FacetFrame& frame = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0),
+                                                    Vec3(0, 0, 1)}) {
   FacetMesh mesh(region, {PointId(corner_base), PointId(corner_base + 1), PointId(corner_base + 2),
                           PointId(corner_base + 3)});
+  BallStore balls;
+  const FeatureId feature(7);
+  const MeshId mesh_id(1);
+  // The seed triangles contain F, so they are in F (they meet its segments).
+  mesh.CreateAllTriangleBalls(frame, feature, mesh_id, &balls);
+  EXPECT_EQ(balls.NumAlive(), 2u);
   std::set<uint32_t> seen;
+  auto insert = [&](Vec2 uv, PointId p) {
+    const auto r = mesh.Insert(uv, p);
+    EXPECT_EQ(r.outcome, delaunay::Delaunay2::InsertOutcome::kInserted);
+    mesh.SyncTriangleBalls(r, frame, feature, mesh_id, &balls);
+  };
   for (const auto& loop : region.loops) {
     for (size_t i = 0; i < loop.uv.size(); ++i) {
       if (!seen.insert(loop.points[i].value()).second) continue;
-      const auto r = mesh.Insert(loop.uv[i], loop.points[i]);
-      EXPECT_EQ(r.outcome, delaunay::Delaunay2::InsertOutcome::kInserted);
+      insert(loop.uv[i], loop.points[i]);
     }
   }
   for (size_t i = 0; i < region.interior_uv.size(); ++i) {
-    mesh.Insert(region.interior_uv[i], region.interior_points[i]);
+    insert(region.interior_uv[i], region.interior_points[i]);
   }
+  CheckTriangleBalls(mesh, balls, frame);
   EXPECT_TRUE(mesh.dt().Validate().ok()) << mesh.dt().Validate();
   const auto& dt = mesh.dt();
   std::set<std::pair<uint32_t, uint32_t>> edges;
@@ -230,14 +268,16 @@ int CheckCorpusFacets(const char* file) {
                              frame.ToPlane(norm->Forward(pts[t[2]]))));
     }
     EXPECT_GT(area, 0);
-    // Loop points project onto the frame plane (normalised) within rounding.
+    // Loop points project onto the frame plane (normalised) within rounding,
+    // and their uv maps back to their xyz within rounding.
     for (const auto& loop : r.loops) {
-      for (PointId p : loop.points) {
-        const Vec3 x = norm->Forward(pts[p.value()]);
+      for (size_t i = 0; i < loop.points.size(); ++i) {
+        const Vec3 x = norm->Forward(pts[loop.points[i].value()]);
         EXPECT_NEAR(geom::Dot(x - frame.origin, frame.normal), 0, 1e-14);
+        EXPECT_LE(geom::Dist(frame.ToSpace(loop.uv[i]), x), 1e-14);
       }
     }
-    conforming += CheckFacetMesh(r, static_cast<uint32_t>(pts.size()) + 4 * f, area);
+    conforming += CheckFacetMesh(r, static_cast<uint32_t>(pts.size()) + 4 * f, area, frame);
   }
   return conforming;
 }
