@@ -458,6 +458,11 @@ TEST(Conformity, InternalFacetCellsRegionByRegion) {
   const ConformityReport rm = CheckConformity(missing.plc, missing.mesh);
   EXPECT_EQ(rm.Count(ViolationKind::kVolumeMismatch), 1u) << rm.Summary();
   EXPECT_EQ(rm.Count(ViolationKind::kOpenFace), 0u) << rm.Summary();
+  // The deleted region's own facets (x = 0 and the four x < ½ halves) bound a
+  // meshed cell, so they must be covered although no tet touches them (the
+  // rule before cells took them for facets outside the domain).
+  EXPECT_EQ(rm.Count(ViolationKind::kFacetNotCovered), 5u) << rm.Summary();
+  EXPECT_EQ(rm.num_facets_outside, 0u);
   ASSERT_FALSE(rm.violations.empty());
   bool named = false;
   for (const Violation& v : rm.violations) {
@@ -491,6 +496,40 @@ TEST(Conformity, InternalFacetCellsRegionByRegion) {
                     v.message.find("more than once") != std::string::npos);
   }
   EXPECT_TRUE(more) << rt.Summary();
+}
+
+TEST(Conformity, FacetOutsideTheDomainIsDecidedByItsCells) {
+  // A square hanging outside the box (the unbounded cell on both sides) is
+  // not required; the facets of a deleted region, which bound a meshed cell,
+  // are (InternalFacetCellsRegionByRegion).
+  SplitBox b = ProperSplitBox(2);
+  const uint32_t base = static_cast<uint32_t>(b.plc.vertices.size());
+  for (const Vec3& p : {Vec3(2, 0, 0), Vec3(3, 0, 0), Vec3(3, 1, 0), Vec3(2, 1, 0)}) {
+    b.plc.vertices.push_back(p);
+  }
+  plc::Facet f;
+  f.polygons.push_back({{base, base + 1, base + 2, base + 3}});
+  f.marker = 9;
+  b.plc.facets.push_back(f);
+  b.mesh.positions.insert(b.mesh.positions.begin() + base, b.plc.vertices.begin() + base,
+                          b.plc.vertices.end());
+  for (auto& t : b.mesh.tets) {
+    for (uint32_t& v : t) v += v >= base ? 4 : 0;
+  }
+  for (auto& t : b.mesh.triangles) {
+    for (uint32_t& v : t) v += v >= base ? 4 : 0;
+  }
+  b.mesh.num_input_vertices = base + 4;
+  const ConformityReport r = CheckConformity(b.plc, b.mesh);
+  ASSERT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_EQ(r.num_cells, 2u);
+  EXPECT_EQ(r.num_facets_outside, 1u);
+  EXPECT_EQ(r.Count(ViolationKind::kFacetNotCovered), 0u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kCoverage), 0u) << r.Summary();
+  // Its four edges are still segments the mesh must contain: segments are
+  // not classified by cells (docs/conformity.md).
+  EXPECT_EQ(r.Count(ViolationKind::kBrokenSegment), 4u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kConformity), 4u) << r.Summary();
 }
 
 TEST(Conformity, ScalesToHundredsOfThousandsOfTets) {
