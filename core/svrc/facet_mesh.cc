@@ -47,6 +47,28 @@ void FacetRegion::AddLoop(std::vector<Vec2> uv, std::vector<PointId> points, boo
   loops.push_back(std::move(l));
 }
 
+void FacetRegion::CollectPoints() {
+  std::vector<std::pair<uint32_t, Vec2>> pts;
+  for (const Loop& l : loops) {
+    for (size_t i = 0; i < l.uv.size(); ++i) pts.push_back({l.points[i].value(), l.uv[i]});
+  }
+  for (size_t i = 0; i < segments.size(); ++i) {
+    for (int k = 0; k < 2; ++k) pts.push_back({segment_points[i][k].value(), segments[i][k]});
+  }
+  for (size_t i = 0; i < interior_uv.size(); ++i) {
+    pts.push_back({interior_points[i].value(), interior_uv[i]});
+  }
+  std::sort(pts.begin(), pts.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  all_uv.clear();
+  all_points.clear();
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (i > 0 && pts[i].first == pts[i - 1].first) continue;
+    all_points.push_back(PointId(pts[i].first));
+    all_uv.push_back(pts[i].second);
+  }
+}
+
 FacetRegion::Where FacetRegion::Locate(Vec2 p) const {
   // Crossing number along the ray from p towards +x, half-open in y; each
   // "edge right of p" decision is an exact Orient2d sign.
@@ -129,6 +151,7 @@ FacetRegion BuildFacetRegion(const plc::FeatureComplex& complex, uint32_t facet,
     r.interior_uv.push_back(uv_of(p));
     r.interior_points.push_back(point_ids[p]);
   }
+  r.CollectPoints();
   if (normalised_frame != nullptr) *normalised_frame = frame;
   return r;
 }

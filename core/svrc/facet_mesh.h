@@ -36,6 +36,13 @@ struct FacetRegion {
   // Isolated points in F's interior (they become vertices of M_F as well).
   std::vector<geom::Vec2> interior_uv;
   std::vector<PointId> interior_points;
+  // Every point of F once (loop points, endpoints of its segments — in-facet
+  // segments are not loops —, interior points), by increasing global id: the
+  // vertices M_F must contain.
+  std::vector<geom::Vec2> all_uv;
+  std::vector<PointId> all_points;
+  // Fills all_uv/all_points from loops, segments and interior points.
+  void CollectPoints();
 
   // Adds a loop (computes its area).
   void AddLoop(std::vector<geom::Vec2> uv, std::vector<PointId> points, bool is_hole);

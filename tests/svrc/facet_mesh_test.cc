@@ -53,6 +53,7 @@ FacetRegion HoledSquare(uint32_t* next) {
   FacetRegion r;
   AddLoopWithSegments(&r, SquareLoop(0, 4, 8), false, next);
   AddLoopWithSegments(&r, SquareLoop(1.5, 2.5, 2), true, next);
+  r.CollectPoints();
   return r;
 }
 
@@ -139,20 +140,21 @@ bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double face
   // The seed triangles contain F, so they are in F (they meet its segments).
   mesh.CreateAllTriangleBalls(frame, feature, mesh_id, &balls);
   EXPECT_EQ(balls.NumAlive(), 2u);
-  std::set<uint32_t> seen;
-  auto insert = [&](Vec2 uv, PointId p) {
-    const auto r = mesh.Insert(uv, p);
+  // Every loop point, segment endpoint and interior point is in all_points.
+  std::set<uint32_t> all;
+  for (PointId p : region.all_points) all.insert(p.value());
+  EXPECT_EQ(all.size(), region.all_points.size());
+  for (const auto& loop : region.loops) {
+    for (PointId p : loop.points) EXPECT_TRUE(all.count(p.value()));
+  }
+  for (const auto& s : region.segment_points) {
+    EXPECT_TRUE(all.count(s[0].value()) && all.count(s[1].value()));
+  }
+  for (PointId p : region.interior_points) EXPECT_TRUE(all.count(p.value()));
+  for (size_t i = 0; i < region.all_points.size(); ++i) {
+    const auto r = mesh.Insert(region.all_uv[i], region.all_points[i]);
     EXPECT_EQ(r.outcome, delaunay::Delaunay2::InsertOutcome::kInserted);
     mesh.SyncTriangleBalls(r, frame, feature, mesh_id, &balls);
-  };
-  for (const auto& loop : region.loops) {
-    for (size_t i = 0; i < loop.uv.size(); ++i) {
-      if (!seen.insert(loop.points[i].value()).second) continue;
-      insert(loop.uv[i], loop.points[i]);
-    }
-  }
-  for (size_t i = 0; i < region.interior_uv.size(); ++i) {
-    insert(region.interior_uv[i], region.interior_points[i]);
   }
   CheckTriangleBalls(mesh, balls, frame);
   EXPECT_TRUE(mesh.dt().Validate().ok()) << mesh.dt().Validate();
@@ -214,6 +216,29 @@ TEST(FacetMeshTest, HoledSquareCoversFacetMinusHole) {
   uint32_t next = 0;
   const FacetRegion r = HoledSquare(&next);
   EXPECT_TRUE(CheckFacetMesh(r, next, 16.0 - 1.0));
+}
+
+// An in-facet segment (not a loop: only its pieces and endpoints are given)
+// and an isolated interior point: both sides of the segment are in F, and
+// its endpoints and the point become M_F vertices.
+TEST(FacetMeshTest, InFacetSegmentAndIsolatedPoint) {
+  FacetRegion r;
+  uint32_t next = 0;
+  AddLoopWithSegments(&r, SquareLoop(0, 4, 8), false, &next);
+  uint32_t prev = next++;
+  for (int i = 1; i <= 4; ++i) {
+    const uint32_t cur = next++;
+    r.segments.push_back({Vec2{1 + 0.5 * (i - 1), 2}, Vec2{1 + 0.5 * i, 2}});
+    r.segment_points.push_back({PointId(prev), PointId(cur)});
+    prev = cur;
+  }
+  r.interior_uv.push_back({2, 3.25});
+  r.interior_points.push_back(PointId(next++));
+  r.CollectPoints();
+  EXPECT_EQ(r.all_points.size(), 32u + 5u + 1u);
+  EXPECT_EQ(r.Locate({2, 1.9}), FacetRegion::Where::kInside);
+  EXPECT_EQ(r.Locate({2, 2.1}), FacetRegion::Where::kInside);
+  EXPECT_TRUE(CheckFacetMesh(r, next, 16.0));
 }
 
 TEST(FacetMeshTest, CornerCellOfSquareWithOnePoint) {
