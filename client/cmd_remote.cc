@@ -1,5 +1,7 @@
 // The remote commands: submit, watch, get, cancel, delete, list, health.
 // Built only with SVRC_BUILD_SERVICE. --server defaults to localhost:50051.
+// Every command takes --tls-ca, --tls-cert, --tls-key, --token-file (or env
+// SVRC_TOKEN) for a TLS / authenticated server (docs/security.md).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -34,6 +36,17 @@ int JobExitCode(const v1::Job& job) {
                                       job.error().message()),
                          /*job_outcome=*/true);
   }
+}
+
+// Every remote command takes the connection-security flags (docs/security.md).
+std::vector<std::string> Remote(std::vector<std::string> flags) {
+  flags.insert(flags.end(), {"--tls-ca", "--tls-cert", "--tls-key", "--token-file"});
+  return flags;
+}
+
+absl::StatusOr<ClientSecurity> SecurityFor(const Args& args) {
+  return SecurityFromFlags(args.Get("--tls-ca"), args.Get("--tls-cert"), args.Get("--tls-key"),
+                           args.Get("--token-file"));
 }
 
 int RpcFail(const absl::Status& s, const std::string& server) {
@@ -106,6 +119,7 @@ const RegisterCommand kRegSubmit{kSubmit};
 int RunSubmit(const std::vector<std::string>& argv) {
   std::vector<std::string> values = MeshValueFlags();
   values.insert(values.end(), {"-o", "--server", "--request-id"});
+  values = Remote(std::move(values));
   std::vector<std::string> switches = MeshSwitches();
   switches.push_back("--watch");
   absl::StatusOr<Args> args = ParseArgs(argv, values, switches);
@@ -122,7 +136,9 @@ int RunSubmit(const std::vector<std::string>& argv) {
   api::OptionsToRequest(*options, &*request);
   request->set_request_id(args->Get("--request-id", NewRequestId()));
 
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   absl::StatusOr<v1::Job> job = client.Submit(*std::move(request));
   if (!job.ok()) return RpcFail(job.status(), server);
   if (!watch && out.empty()) {
@@ -139,11 +155,13 @@ const Command kWatch{"watch", "watch ID [--server HOST:PORT] [-o OUT]", &RunWatc
 const RegisterCommand kRegWatch{kWatch};
 
 int RunWatch(const std::vector<std::string>& argv) {
-  absl::StatusOr<Args> args = ParseArgs(argv, {"-o", "--server"}, {});
+  absl::StatusOr<Args> args = ParseArgs(argv, Remote({"-o", "--server"}), {});
   if (!args.ok()) return UsageError(kWatch, std::string(args.status().message()));
   if (args->positional.size() != 1) return UsageError(kWatch, "expected one job id");
   const std::string server = args->Get("--server", kDefaultServer);
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   return WatchToEnd(client, args->positional[0], args->Get("-o"), true, server);
 }
 
@@ -154,11 +172,13 @@ const Command kGet{"get", "get ID [--server HOST:PORT] [-o OUT]   (without -o: t
 const RegisterCommand kRegGet{kGet};
 
 int RunGet(const std::vector<std::string>& argv) {
-  absl::StatusOr<Args> args = ParseArgs(argv, {"-o", "--server"}, {});
+  absl::StatusOr<Args> args = ParseArgs(argv, Remote({"-o", "--server"}), {});
   if (!args.ok()) return UsageError(kGet, std::string(args.status().message()));
   if (args->positional.size() != 1) return UsageError(kGet, "expected one job id");
   const std::string server = args->Get("--server", kDefaultServer);
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   absl::StatusOr<v1::Job> job = client.Get(args->positional[0]);
   if (!job.ok()) return RpcFail(job.status(), server);
   const std::string out = args->Get("-o");
@@ -192,11 +212,13 @@ const Command kCancel{"cancel", "cancel ID [--server HOST:PORT]", &RunCancel};
 const RegisterCommand kRegCancel{kCancel};
 
 int RunCancel(const std::vector<std::string>& argv) {
-  absl::StatusOr<Args> args = ParseArgs(argv, {"--server"}, {});
+  absl::StatusOr<Args> args = ParseArgs(argv, Remote({"--server"}), {});
   if (!args.ok()) return UsageError(kCancel, std::string(args.status().message()));
   if (args->positional.size() != 1) return UsageError(kCancel, "expected one job id");
   const std::string server = args->Get("--server", kDefaultServer);
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   absl::StatusOr<v1::Job> job = client.Cancel(args->positional[0]);
   if (!job.ok()) return RpcFail(job.status(), server);
   std::printf("job %s %s%s\n", job->job_id().c_str(), api::JobStateName(job->state()).c_str(),
@@ -213,11 +235,13 @@ const Command kDelete{"delete", "delete ID [--server HOST:PORT]   (forgets a fin
 const RegisterCommand kRegDelete{kDelete};
 
 int RunDelete(const std::vector<std::string>& argv) {
-  absl::StatusOr<Args> args = ParseArgs(argv, {"--server"}, {});
+  absl::StatusOr<Args> args = ParseArgs(argv, Remote({"--server"}), {});
   if (!args.ok()) return UsageError(kDelete, std::string(args.status().message()));
   if (args->positional.size() != 1) return UsageError(kDelete, "expected one job id");
   const std::string server = args->Get("--server", kDefaultServer);
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   if (absl::Status s = client.Delete(args->positional[0]); !s.ok()) return RpcFail(s, server);
   std::printf("job %s deleted\n", args->positional[0].c_str());
   return kExitOk;
@@ -230,7 +254,7 @@ const Command kList{"list", "list [--server HOST:PORT] [--state QUEUED,RUNNING,.
 const RegisterCommand kRegList{kList};
 
 int RunList(const std::vector<std::string>& argv) {
-  absl::StatusOr<Args> args = ParseArgs(argv, {"--server", "--state", "--page-size"}, {});
+  absl::StatusOr<Args> args = ParseArgs(argv, Remote({"--server", "--state", "--page-size"}), {});
   if (!args.ok()) return UsageError(kList, std::string(args.status().message()));
   if (!args->positional.empty()) return UsageError(kList, "no positional arguments");
   const std::string server = args->Get("--server", kDefaultServer);
@@ -249,7 +273,9 @@ int RunList(const std::vector<std::string>& argv) {
     return UsageError(kList, "--page-size must be a positive integer");
   }
   request.set_page_size(page_size);
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   std::printf("%-18s %-10s %-10s %10s  %s\n", "JOB", "STATE", "PHASE", "VERTICES", "INPUT");
   do {
     absl::StatusOr<v1::ListJobsResponse> page = client.List(request);
@@ -267,15 +293,17 @@ int RunList(const std::vector<std::string>& argv) {
 
 // ---- health ----
 int RunHealth(const std::vector<std::string>& argv);
-const Command kHealth{"health", "health [--server HOST:PORT]   (exit 0 only when SERVING)",
+const Command kHealth{"health", "health [--server HOST:PORT] [--tls-ca PEM] [--token-file F]   (exit 0 only when SERVING)",
                       &RunHealth};
 const RegisterCommand kRegHealth{kHealth};
 
 int RunHealth(const std::vector<std::string>& argv) {
-  absl::StatusOr<Args> args = ParseArgs(argv, {"--server"}, {});
+  absl::StatusOr<Args> args = ParseArgs(argv, Remote({"--server"}), {});
   if (!args.ok()) return UsageError(kHealth, std::string(args.status().message()));
   const std::string server = args->Get("--server", kDefaultServer);
-  RemoteClient client(server);
+  absl::StatusOr<ClientSecurity> security = SecurityFor(*args);
+  if (!security.ok()) return RpcFail(security.status(), server);
+  RemoteClient client(server, *security);
   absl::StatusOr<bool> serving = client.Serving();
   if (!serving.ok()) return RpcFail(serving.status(), server);
   std::printf("%s\n", *serving ? "SERVING" : "NOT_SERVING");

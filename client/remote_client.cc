@@ -1,5 +1,7 @@
 #include "client/remote_client.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <fstream>
@@ -49,8 +51,77 @@ RemoteClient::RemoteClient(const std::string& target, absl::Duration rpc_timeout
       stub_(v1::MeshingService::NewStub(channel_)),
       rpc_timeout_(rpc_timeout) {}
 
+namespace {
+
+std::string ReadOrEmpty(const std::string& path, bool* ok) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *ok = false;
+    return "";
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::shared_ptr<grpc::ChannelCredentials> Credentials(const ClientSecurity& s) {
+  if (s.tls_ca.empty() && s.tls_cert.empty()) return grpc::InsecureChannelCredentials();
+  grpc::SslCredentialsOptions options;
+  bool ok = true;
+  if (!s.tls_ca.empty()) options.pem_root_certs = ReadOrEmpty(s.tls_ca, &ok);
+  if (!s.tls_cert.empty()) options.pem_cert_chain = ReadOrEmpty(s.tls_cert, &ok);
+  if (!s.tls_key.empty()) options.pem_private_key = ReadOrEmpty(s.tls_key, &ok);
+  if (!ok) std::fprintf(stderr, "svrc: cannot read a TLS file (--tls-ca/--tls-cert/--tls-key)\n");
+  return grpc::SslCredentials(options);
+}
+
+}  // namespace
+
+absl::StatusOr<ClientSecurity> SecurityFromFlags(const std::string& tls_ca,
+                                                 const std::string& tls_cert,
+                                                 const std::string& tls_key,
+                                                 const std::string& token_file) {
+  ClientSecurity s;
+  s.tls_ca = tls_ca;
+  s.tls_cert = tls_cert;
+  s.tls_key = tls_key;
+  if (tls_cert.empty() != tls_key.empty()) {
+    return absl::InvalidArgumentError("--tls-cert and --tls-key go together");
+  }
+  for (const std::string* path : {&tls_ca, &tls_cert, &tls_key}) {
+    if (!path->empty() && !std::filesystem::exists(*path)) {
+      return absl::NotFoundError(absl::StrCat("cannot read ", *path));
+    }
+  }
+  if (!token_file.empty()) {
+    bool ok = true;
+    s.token = ReadOrEmpty(token_file, &ok);
+    if (!ok) return absl::NotFoundError(absl::StrCat("cannot read ", token_file));
+    while (!s.token.empty() && (s.token.back() == '\n' || s.token.back() == '\r' ||
+                                s.token.back() == ' ')) {
+      s.token.pop_back();
+    }
+    if (s.token.empty()) return absl::InvalidArgumentError(absl::StrCat(token_file, " is empty"));
+  } else if (const char* env = std::getenv("SVRC_TOKEN"); env != nullptr) {
+    s.token = env;
+  }
+  return s;
+}
+
+RemoteClient::RemoteClient(const std::string& target, const ClientSecurity& security,
+                           absl::Duration rpc_timeout)
+    : channel_(grpc::CreateChannel(target, Credentials(security))),
+      stub_(v1::MeshingService::NewStub(channel_)),
+      rpc_timeout_(rpc_timeout),
+      token_(security.token) {}
+
+void RemoteClient::Authorize(grpc::ClientContext* context) const {
+  if (!token_.empty()) context->AddMetadata("authorization", "Bearer " + token_);
+}
+
 void RemoteClient::SetDeadline(grpc::ClientContext* context) const {
   context->set_deadline(std::chrono::system_clock::now() + absl::ToChronoMilliseconds(rpc_timeout_));
+  Authorize(context);
 }
 
 absl::StatusOr<v1::Job> RemoteClient::SubmitOnce(const v1::SubmitJobRequest& request) {
@@ -141,6 +212,7 @@ absl::StatusOr<v1::Job> RemoteClient::Watch(
   for (int attempt = 0; attempt <= reconnects; ++attempt) {
     if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(200 << attempt));
     grpc::ClientContext context;
+    Authorize(&context);
     std::unique_ptr<grpc::ClientReader<v1::JobEvent>> reader = stub_->WatchJob(&context, request);
     v1::JobEvent event;
     std::optional<v1::Job> terminal;
@@ -162,6 +234,7 @@ absl::Status RemoteClient::FetchFrom(const std::string& job_id, uint64_t offset,
                                      uint64_t* total_size, std::string* sha256,
                                      uint32_t max_chunk_bytes) {
   grpc::ClientContext context;
+  Authorize(&context);
   v1::FetchResultRequest request;
   request.set_job_id(job_id);
   request.set_offset(offset);

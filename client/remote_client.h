@@ -28,6 +28,22 @@ absl::StatusOr<v1::SubmitJobRequest> RequestForFile(const std::string& path);
 // A fresh random request id (128 bits, hex).
 std::string NewRequestId();
 
+// How the client proves who it is and checks the server (docs/security.md).
+struct ClientSecurity {
+  std::string tls_ca;    // PEM file of the CA that signed the server; TLS when set
+  std::string tls_cert;  // client certificate + key (PEM files) for mTLS
+  std::string tls_key;
+  std::string token;     // bearer token sent as "authorization: Bearer ..."
+};
+
+// A ClientSecurity from the CLI's --tls-ca/--tls-cert/--tls-key/--token-file
+// values (empty: unset); without --token-file the token comes from the
+// environment variable SVRC_TOKEN when set. Reads the token file.
+absl::StatusOr<ClientSecurity> SecurityFromFlags(const std::string& tls_ca,
+                                                 const std::string& tls_cert,
+                                                 const std::string& tls_key,
+                                                 const std::string& token_file);
+
 struct FetchedResult {
   std::string bytes;   // the whole container
   std::string sha256;  // hex, checked against `bytes`
@@ -43,6 +59,10 @@ class RemoteClient {
   // "host:port"; connects lazily on the first call.
   explicit RemoteClient(const std::string& target,
                         absl::Duration rpc_timeout = absl::Seconds(60));
+  // With TLS and/or a bearer token. TLS files that cannot be read make every
+  // call fail with the reading error (status()).
+  RemoteClient(const std::string& target, const ClientSecurity& security,
+               absl::Duration rpc_timeout = absl::Seconds(60));
 
   // Fills request_id when empty so that retries (UNAVAILABLE, up to
   // `attempts` calls) are idempotent; large files are streamed.
@@ -74,12 +94,15 @@ class RemoteClient {
   v1::MeshingService::Stub& stub() { return *stub_; }
 
  private:
+  // Sets the per-call deadline and the bearer token.
   void SetDeadline(grpc::ClientContext* context) const;
+  void Authorize(grpc::ClientContext* context) const;
   absl::StatusOr<v1::Job> SubmitOnce(const v1::SubmitJobRequest& request);
 
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::MeshingService::Stub> stub_;
   absl::Duration rpc_timeout_;
+  std::string token_;
 };
 
 }  // namespace svrc::cli

@@ -19,6 +19,7 @@ TEST_PKGS=(
   libgmp-dev libcgal-dev tetgen gmsh python3 python3-vtk9 python3-numpy python3-grpcio
   zlib1g-dev
   clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz, docs/fuzzing.md)
+  openssl  # tests/server/security_test.cc makes its TLS certificates
 )
 RUNTIME_PKGS=(
   libabsl20220623 libspdlog1.10 libdraco7 libgrpc++1.51 libprotobuf32 libgmp10 ca-certificates

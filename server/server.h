@@ -31,6 +31,13 @@ struct ServerOptions {
   // Largest input accepted through UploadJob.
   uint64_t max_upload_bytes = uint64_t{2} << 30;
   absl::Duration progress_interval = absl::Milliseconds(100);
+  // TLS: server certificate chain and private key (PEM files); with
+  // tls_client_ca too, clients must present a certificate it signed (mTLS).
+  std::string tls_cert, tls_key, tls_client_ca;
+  // "TOKEN CLIENT_NAME" lines; empty: no authentication (docs/security.md).
+  std::string token_file;
+  // Queued + running jobs per client; 0: unlimited.
+  int max_jobs_per_client = 0;
 };
 
 class Server {
@@ -56,6 +63,7 @@ class Server {
   ServerOptions options_;
   std::string address_;
   int port_ = 0;
+  std::unique_ptr<TokenAuth> auth_;
   std::unique_ptr<JobManager> manager_;
   std::unique_ptr<MeshingServiceImpl> service_;
   std::unique_ptr<grpc::Server> grpc_server_;

@@ -29,8 +29,13 @@ grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context,
 class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest> {
  public:
   UploadReactor(grpc::CallbackServerContext* context, JobManager* manager, uint64_t max_bytes,
-                v1::Job* response)
+                v1::Job* response, absl::StatusOr<std::string> owner)
       : context_(context), manager_(manager), max_bytes_(max_bytes), response_(response) {
+    if (!owner.ok()) {
+      Finish(ToGrpcStatus(owner.status()));
+      return;
+    }
+    owner_ = *std::move(owner);
     StartRead(&message_);
   }
 
@@ -93,7 +98,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
                           absl::StrCat("upload ended after ", got, " of ", total_bytes_, " bytes")));
       return;
     }
-    absl::StatusOr<v1::Job> job = manager_->Submit(std::move(request_));
+    absl::StatusOr<v1::Job> job = manager_->Submit(std::move(request_), owner_);
     if (job.ok()) *response_ = std::move(*job);
     Finish(ToGrpcStatus(job.status()));
   }
@@ -103,6 +108,7 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
   const uint64_t max_bytes_;
   uint64_t total_bytes_ = 0;
   v1::Job* response_;
+  std::string owner_;
   v1::UploadJobRequest message_;
   v1::SubmitJobRequest request_;
   bool have_header_ = false;
@@ -113,10 +119,19 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
 // snapshots replace an unsent one, since each carries the whole job.
 class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
  public:
-  WatchReactor(JobManager* manager, const std::string& job_id)
+  WatchReactor(JobManager* manager, const std::string& job_id,
+               const absl::StatusOr<std::string>& owner)
       : manager_(manager), job_id_(job_id) {
+    if (!owner.ok()) {
+      {
+        absl::MutexLock lock(&mu_);
+        finished_ = true;
+      }
+      Finish(ToGrpcStatus(owner.status()));
+      return;
+    }
     absl::StatusOr<uint64_t> token =
-        manager_->Subscribe(job_id_, [this](const v1::JobEvent& e) { Push(e); });
+        manager_->Subscribe(job_id_, [this](const v1::JobEvent& e) { Push(e); }, *owner);
     if (!token.ok()) {
       Finish(ToGrpcStatus(token.status()));
       return;
@@ -208,13 +223,18 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
 // ahead on its own thread).
 class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
  public:
-  FetchReactor(JobManager* manager, const v1::FetchResultRequest& request)
+  FetchReactor(JobManager* manager, const v1::FetchResultRequest& request,
+               const absl::StatusOr<std::string>& owner)
       : manager_(manager), job_id_(request.job_id()), offset_(request.offset()) {
+    if (!owner.ok()) {
+      Finish(ToGrpcStatus(owner.status()));
+      return;
+    }
     chunk_bytes_ = request.max_chunk_bytes() == 0 ||
                            request.max_chunk_bytes() > MeshingServiceImpl::kMaxChunkBytes
                        ? MeshingServiceImpl::kMaxChunkBytes
                        : request.max_chunk_bytes();
-    absl::StatusOr<StoredResult> stored = manager_->Result(job_id_);
+    absl::StatusOr<StoredResult> stored = manager_->Result(job_id_, *owner);
     if (!stored.ok()) {
       Finish(ToGrpcStatus(stored.status()));
       return;
@@ -276,49 +296,69 @@ class FetchReactor final : public grpc::ServerWriteReactor<v1::ResultChunk> {
 grpc::ServerUnaryReactor* MeshingServiceImpl::SubmitJob(grpc::CallbackServerContext* context,
                                                         const v1::SubmitJobRequest* request,
                                                         v1::Job* response) {
+  absl::StatusOr<std::string> owner = Caller(context);
+  if (!owner.ok()) return FinishUnary<v1::Job>(context, owner.status(), response);
   // One copy of the (<= 4 MiB) request; the manager owns it from here.
-  return FinishUnary(context, manager_->Submit(*request), response);
+  return FinishUnary(context, manager_->Submit(*request, *owner), response);
 }
 
 grpc::ServerReadReactor<v1::UploadJobRequest>* MeshingServiceImpl::UploadJob(
     grpc::CallbackServerContext* context, v1::Job* response) {
-  return new UploadReactor(context, manager_, max_upload_bytes_, response);
+  return new UploadReactor(context, manager_, max_upload_bytes_, response, Caller(context));
 }
 
 grpc::ServerWriteReactor<v1::JobEvent>* MeshingServiceImpl::WatchJob(
     grpc::CallbackServerContext* context, const v1::WatchJobRequest* request) {
-  return new WatchReactor(manager_, request->job_id());
+  return new WatchReactor(manager_, request->job_id(), Caller(context));
 }
 
 grpc::ServerUnaryReactor* MeshingServiceImpl::GetJob(grpc::CallbackServerContext* context,
                                                      const v1::GetJobRequest* request,
                                                      v1::Job* response) {
-  return FinishUnary(context, manager_->Get(request->job_id()), response);
+  absl::StatusOr<std::string> owner = Caller(context);
+  if (!owner.ok()) return FinishUnary<v1::Job>(context, owner.status(), response);
+  return FinishUnary(context, manager_->Get(request->job_id(), *owner), response);
 }
 
 grpc::ServerUnaryReactor* MeshingServiceImpl::ListJobs(grpc::CallbackServerContext* context,
                                                        const v1::ListJobsRequest* request,
                                                        v1::ListJobsResponse* response) {
-  return FinishUnary(context, manager_->List(*request), response);
+  absl::StatusOr<std::string> owner = Caller(context);
+  if (!owner.ok()) return FinishUnary<v1::ListJobsResponse>(context, owner.status(), response);
+  return FinishUnary(context, manager_->List(*request, *owner), response);
 }
 
 grpc::ServerUnaryReactor* MeshingServiceImpl::CancelJob(grpc::CallbackServerContext* context,
                                                         const v1::CancelJobRequest* request,
                                                         v1::Job* response) {
-  return FinishUnary(context, manager_->Cancel(request->job_id()), response);
+  absl::StatusOr<std::string> owner = Caller(context);
+  if (!owner.ok()) return FinishUnary<v1::Job>(context, owner.status(), response);
+  return FinishUnary(context, manager_->Cancel(request->job_id(), *owner), response);
 }
 
 grpc::ServerUnaryReactor* MeshingServiceImpl::DeleteJob(grpc::CallbackServerContext* context,
                                                         const v1::DeleteJobRequest* request,
                                                         v1::DeleteJobResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  reactor->Finish(ToGrpcStatus(manager_->Delete(request->job_id())));
+  absl::StatusOr<std::string> owner = Caller(context);
+  reactor->Finish(ToGrpcStatus(owner.ok() ? manager_->Delete(request->job_id(), *owner)
+                                          : owner.status()));
   return reactor;
 }
 
 grpc::ServerWriteReactor<v1::ResultChunk>* MeshingServiceImpl::FetchResult(
     grpc::CallbackServerContext* context, const v1::FetchResultRequest* request) {
-  return new FetchReactor(manager_, *request);
+  return new FetchReactor(manager_, *request, Caller(context));
+}
+
+absl::StatusOr<std::string> MeshingServiceImpl::Caller(grpc::CallbackServerContext* context) const {
+  if (auth_ == nullptr) return std::string();
+  absl::StatusOr<std::string> client = auth_->Authenticate(*context);
+  if (!client.ok()) {
+    ServerLog().warn("refused a call from {}: {}", context->peer(),
+                     std::string(client.status().message()));
+  }
+  return client;
 }
 
 }  // namespace svrc::server

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "server/auth.h"
 #include "server/job_manager.h"
 #include "svrc/v1/service.grpc.pb.h"
 
@@ -15,8 +16,11 @@ class MeshingServiceImpl final : public v1::MeshingService::CallbackService {
   // Result chunks are at most this big (the API promises <= 1 MiB).
   static constexpr uint32_t kMaxChunkBytes = 1 << 20;
 
-  MeshingServiceImpl(JobManager* manager, uint64_t max_upload_bytes)
-      : manager_(manager), max_upload_bytes_(max_upload_bytes) {}
+  // With `auth` (may be null: no authentication, every caller is client ""),
+  // every call needs a valid bearer token and sees only its client's jobs.
+  MeshingServiceImpl(JobManager* manager, uint64_t max_upload_bytes,
+                     const TokenAuth* auth = nullptr)
+      : manager_(manager), max_upload_bytes_(max_upload_bytes), auth_(auth) {}
 
   grpc::ServerUnaryReactor* SubmitJob(grpc::CallbackServerContext* context,
                                       const v1::SubmitJobRequest* request,
@@ -40,8 +44,12 @@ class MeshingServiceImpl final : public v1::MeshingService::CallbackService {
       grpc::CallbackServerContext* context, const v1::FetchResultRequest* request) override;
 
  private:
+  // The calling client's name ("" without auth) or UNAUTHENTICATED.
+  absl::StatusOr<std::string> Caller(grpc::CallbackServerContext* context) const;
+
   JobManager* manager_;
   const uint64_t max_upload_bytes_;
+  const TokenAuth* auth_;
 };
 
 }  // namespace svrc::server
