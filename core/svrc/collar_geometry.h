@@ -50,6 +50,8 @@ struct CollarDescription {
 // cross (|c1c2| ≥ r1 + r2, |c1c2| ≤ |r1 − r2|, or concentric). The normal points
 // from b1's centre to b2's. Radical-plane distance h1 = (d² + r1² − r2²)/(2d),
 // radius² = (r1 − h1)(r1 + h1) (factored: no cancellation near tangency).
+// Whether the spheres cross is a double comparison on constructed radii (collar
+// radii are perturbed anyway, guide §5 item 2), not an exact predicate.
 bool SphereSphereCircle(const CollarBall& b1, const CollarBall& b2, Circle3* out);
 
 // Plane (point p0, normal n, any length) ∩ sphere: false if they do not meet.
@@ -80,7 +82,8 @@ struct Arc {
 // The parts of `circle` not strictly inside any of `others` (thesis §2.4.1: in a
 // facet plane the collar surface is arcs and points). Each ball cuts an open
 // angular interval (solving A cos t + B sin t > D); the complement is returned
-// as sorted arcs in [0, 2π) (an arc through angle 0 is split in two). If no
+// as sorted arcs in [0, 2π) (an arc through angle 0 is split in two). The arc
+// ends are constructions; decide membership of a point with InsideAnyBall. If no
 // ball cuts the circle: one arc [0, 2π]. Empty if the circle is covered.
 std::vector<Arc> ClipCircleByBalls(const Circle3& circle, std::span<const CollarBall> others);
 
