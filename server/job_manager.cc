@@ -2,6 +2,7 @@
 
 #include <signal.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <utility>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "google/protobuf/util/time_util.h"
 #include "proto/convert.h"
 #include "server/log.h"
+#include "server/memory_accounting.h"
 #include "server/status_util.h"
 
 namespace svrc::server {
@@ -39,6 +41,8 @@ struct JobManager::JobRecord {
   std::string owner;
   uint32_t attempts = 0;          // runs started (journaled before each)
   bool requeue_on_restart = false;  // cancelled by Shutdown: journaled as QUEUED
+  JobMemory memory;                       // heap held by the job's thread
+  std::atomic<bool> memory_exceeded{false};  // cancelled for its memory budget
   v1::Job job;
   uint64_t event_seq = 0;
   v1::SubmitJobRequest request;  // the input; moved out when the job starts
@@ -380,7 +384,16 @@ void JobManager::Finish(JobRecord* rec, const absl::Status& status) {
   Notify(rec);
 }
 
+void JobManager::CheckMemory(JobRecord* rec) {
+  const uint64_t budget = options_.max_job_memory_bytes;
+  if (budget == 0 || rec->memory.bytes.load(std::memory_order_relaxed) <= static_cast<int64_t>(budget)) {
+    return;
+  }
+  if (!rec->memory_exceeded.exchange(true)) rec->cancel.Cancel();
+}
+
 void JobManager::OnProgress(JobRecord* rec, const core::Progress& progress) {
+  CheckMemory(rec);
   absl::MutexLock lock(&mu_);
   v1::Progress* p = rec->job.mutable_progress();
   const bool phase_changed = p->phase() != progress.phase;
@@ -442,8 +455,15 @@ void JobManager::RunJob(const std::string& job_id) {
   }
   StoredResult stored;
   v1::ResultInfo info;
+  BindThreadMemory(&rec->memory);
   absl::Status status = Execute(rec, request, &stored, &info);
   request.Clear();
+  BindThreadMemory(nullptr);
+  if (rec->memory_exceeded.load() && !status.ok()) {
+    status = absl::ResourceExhaustedError(absl::StrCat(
+        "the job exceeded the server's per-job memory budget of ", options_.max_job_memory_bytes,
+        " bytes (it held ", rec->memory.peak.load(), " bytes)"));
+  }
   absl::MutexLock lock(&mu_);
   --running_;
   rec->job.mutable_progress()->set_elapsed_seconds(absl::ToDoubleSeconds(absl::Now() - rec->started));
@@ -524,6 +544,7 @@ void JobManager::JanitorLoop() {
     const absl::Time now = absl::Now();
     std::vector<std::string> expired;
     for (auto& [id, rec] : jobs_) {
+      if (rec->job.state() == v1::RUNNING) CheckMemory(rec.get());
       if (rec->job.state() == v1::QUEUED && rec->deadline <= now && queue_->Remove(id)) {
         Finish(rec.get(), absl::DeadlineExceededError("job deadline exceeded while queued"));
       }

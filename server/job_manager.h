@@ -119,6 +119,8 @@ class JobManager {
   void Finish(JobRecord* rec, const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void Notify(JobRecord* rec) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
   void OnProgress(JobRecord* rec, const core::Progress& progress);
+  // Cancels a running job whose accounted heap exceeds max_job_memory_bytes.
+  void CheckMemory(JobRecord* rec);
   void JanitorLoop();
 
   const JobManagerOptions options_;

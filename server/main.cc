@@ -22,10 +22,12 @@ constexpr char kUsage[] =
     "                   [--data-dir=DIR] [--retention=DURATION] [--disk-quota-mb=N]\n"
     "                   [--grace-period=DURATION] [--max-upload-mb=N]\n"
     "                   [--tls-cert=PEM --tls-key=PEM [--tls-client-ca=PEM]]\n"
-    "                   [--token-file=FILE] [--max-jobs-per-client=N] [--version]\n"
+    "                   [--token-file=FILE] [--max-jobs-per-client=N]\n"
+    "                   [--max-job-memory-mb=N] [--version]\n"
     "defaults: --listen=127.0.0.1:50051 --workers=2 --queue-capacity=64\n"
     "          --data-dir=./svrc-data --retention=24h --disk-quota-mb=0 (unlimited)\n"
     "          --grace-period=30s --max-upload-mb=2048 --max-jobs-per-client=0 (unlimited)\n"
+    "          --max-job-memory-mb=0 (unlimited)\n"
     "          no TLS, no authentication (docs/security.md: do not expose that)\n";
 
 bool ParseFlag(const std::string& arg, const char* name, std::string* value) {
@@ -86,6 +88,9 @@ int main(int argc, char** argv) {
       options.tls_client_ca = v;
     } else if (ParseFlag(arg, "token-file", &v)) {
       options.token_file = v;
+    } else if (ParseFlag(arg, "max-job-memory-mb", &v)) {
+      if (!absl::SimpleAtoi(v, &n) || n < 0) return Usage("bad --max-job-memory-mb " + v);
+      options.max_job_memory_bytes = static_cast<uint64_t>(n) << 20;
     } else if (ParseFlag(arg, "max-jobs-per-client", &v)) {
       if (!absl::SimpleAtoi(v, &n) || n < 0) return Usage("bad --max-jobs-per-client " + v);
       options.max_jobs_per_client = static_cast<int>(n);

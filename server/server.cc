@@ -42,6 +42,7 @@ absl::StatusOr<std::unique_ptr<Server>> Server::Start(const ServerOptions& optio
   jm.retention = options.retention;
   jm.progress_interval = options.progress_interval;
   jm.max_jobs_per_client = options.max_jobs_per_client;
+  jm.max_job_memory_bytes = options.max_job_memory_bytes;
   server->manager_ = std::make_unique<JobManager>(
       jm, std::make_unique<InMemoryJobQueue>(options.queue_capacity), *std::move(store),
       *std::move(journal));

@@ -38,6 +38,8 @@ struct ServerOptions {
   std::string token_file;
   // Queued + running jobs per client; 0: unlimited.
   int max_jobs_per_client = 0;
+  // Heap one job may hold (server/memory_accounting.h); 0: unlimited.
+  uint64_t max_job_memory_bytes = 0;
 };
 
 class Server {

@@ -231,3 +231,28 @@ TEST(SecurityTest, ServerOnlyTlsWithTokenFromEnvironment) {
 
 }  // namespace
 }  // namespace svrc
+
+namespace svrc {
+namespace {
+
+TEST(LimitsTest, JobOverItsMemoryBudgetEndsResourceExhaustedAndTheServerGoesOn) {
+  ServerProcess server({"--workers=1", "--max-job-memory-mb=16"});
+  ASSERT_TRUE(server.ok());
+  RemoteClient c(server.address());
+  // 300k points: the Delaunay structure alone needs far more than 16 MiB.
+  absl::StatusOr<v1::Job> big = c.Submit(NodeRequest(testing::RandomNodeFile(300000, 9)));
+  ASSERT_TRUE(big.ok()) << big.status();
+  const v1::Job done = WaitTerminal(c, big->job_id());
+  EXPECT_EQ(done.state(), v1::FAILED);
+  EXPECT_EQ(done.error().code(), static_cast<int>(absl::StatusCode::kResourceExhausted))
+      << done.error().message();
+  EXPECT_NE(done.error().message().find("memory budget"), std::string::npos)
+      << done.error().message();
+  // The next job (small) runs normally on the same server.
+  absl::StatusOr<v1::Job> small = c.Submit(NodeRequest(testing::RandomNodeFile(2000, 10)));
+  ASSERT_TRUE(small.ok()) << small.status();
+  EXPECT_EQ(WaitTerminal(c, small->job_id()).state(), v1::SUCCEEDED);
+}
+
+}  // namespace
+}  // namespace svrc
