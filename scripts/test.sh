@@ -3,7 +3,10 @@
 # command does both). Stages, each timed:
 #   1. Release build of everything, all test suites (ctest)
 #   2. ASan+UBSan build of the core (no service), core-labelled suites
-# Env: SVRC_JOBS (default: nproc), SVRC_SKIP_SANITIZE=1 to skip stage 2.
+#   3. TSan build of the server library + its unit suites (queue, pool, store,
+#      journal, job manager); suppressions in tests/server/tsan.supp
+# Env: SVRC_JOBS (default: nproc), SVRC_SKIP_SANITIZE=1 to skip stage 2,
+# SVRC_SKIP_TSAN=1 to skip stage 3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -35,5 +38,17 @@ if [[ "${SVRC_SKIP_SANITIZE:-0}" != 1 ]]; then
   stage "tests (asan/ubsan, label core)"
   ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build/asan -L core -j "$JOBS" --timeout 900
   stage_end "tests asan"
+fi
+if [[ "${SVRC_SKIP_TSAN:-0}" != 1 ]]; then
+  stage "configure+build tsan (server unit suites)"
+  cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DSVRC_SANITIZE=thread >/dev/null
+  cmake --build build/tsan -j "$JOBS" --target svrc_server_unit_tests
+  stage_end "build tsan"
+
+  stage "tests (tsan, server unit suites)"
+  TSAN_OPTIONS="suppressions=$ROOT/tests/server/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
+    timeout 600 build/tsan/tests/server/svrc_server_unit_tests
+  stage_end "tests tsan"
 fi
 echo "=== all stages done in $(( $(date +%s) - t0 )) s"
