@@ -12,6 +12,7 @@
 #include <fstream>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
 #include "gtest/gtest.h"
 #include "server/job_manager.h"
 #include "tests/server/service_test_util.h"
@@ -111,7 +112,7 @@ TEST(JournalTest, ManagerRestartedOnTheJournalServesFinishedJobsAndCompacts) {
                  *std::move(journal));
     for (int i = 0; i < 4; ++i) {
       v1::SubmitJobRequest r;
-      r.set_request_id("r" + std::to_string(i));
+      r.set_request_id(absl::StrCat("r", i));
       r.mutable_file()->set_format(v1::NODE);
       r.mutable_file()->set_name("p.node");
       r.mutable_file()->set_data(testing::RandomNodeFile(200, i + 1));
