@@ -74,8 +74,12 @@ TEST_P(TetgenCorpus, CheckerAcceptsTetgenMesh) {
   EXPECT_TRUE(r.cells_known) << r.cells_unknown_reason;
   EXPECT_TRUE(r.enclosed_volume_known);
   EXPECT_NEAR(r.mesh_volume, r.enclosed_volume, 1e-9 * r.enclosed_volume);
-  if (c.file == "b_internal/box_internal_facet.poly") EXPECT_EQ(r.num_cells, 2u);
-  if (c.file == "b_internal/box_in_box.poly") EXPECT_EQ(r.num_cells, 2u);
+  if (c.file == "b_internal/box_internal_facet.poly") {
+    EXPECT_EQ(r.num_cells, 2u);
+  }
+  if (c.file == "b_internal/box_in_box.poly") {
+    EXPECT_EQ(r.num_cells, 2u);
+  }
   std::printf("%s -%s: %zu vertices, %zu tets, %zu triangles, volume %.17g (enclosed %s)\n",
               c.file.c_str(), c.switches.c_str(), mesh->positions.size(), mesh->tets.size(),
               mesh->triangles.size(), r.mesh_volume,

@@ -11,11 +11,15 @@
 #include "core/codec/container.h"
 #include "core/plc/readers.h"
 #include "gtest/gtest.h"
+#include "tests/server/job_test_util.h"
 #include "tests/server/service_test_util.h"
 #include "tests/test_support.h"
 
 namespace svrc::server {
 namespace {
+
+using testing::NodeRequest;
+using testing::WaitTerminal;
 
 std::unique_ptr<JobManager> MakeManager(int workers, size_t capacity, std::string* dir = nullptr) {
   const std::string d = testing::MakeTempDir("manager");
@@ -28,28 +32,7 @@ std::unique_ptr<JobManager> MakeManager(int workers, size_t capacity, std::strin
                                       *std::move(store));
 }
 
-v1::SubmitJobRequest NodeRequest(const std::string& node, const std::string& request_id = "") {
-  v1::SubmitJobRequest r;
-  r.set_request_id(request_id);
-  r.mutable_file()->set_format(v1::NODE);
-  r.mutable_file()->set_name("points.node");
-  r.mutable_file()->set_data(node);
-  return r;
-}
 
-v1::Job WaitTerminal(JobManager& m, const std::string& id, double timeout_s = 120) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (std::chrono::steady_clock::now() < end) {
-    absl::StatusOr<v1::Job> job = m.Get(id);
-    if (job.ok() && (job->state() == v1::SUCCEEDED || job->state() == v1::FAILED ||
-                     job->state() == v1::CANCELLED)) {
-      return *job;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ADD_FAILURE() << "job " << id << " did not finish";
-  return {};
-}
 
 void WaitRunning(JobManager& m, const std::string& id) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);

@@ -11,41 +11,21 @@
 #include "client/remote_client.h"
 #include "core/util/sha256.h"
 #include "gtest/gtest.h"
+#include "tests/server/job_test_util.h"
 #include "tests/server/service_test_util.h"
 #include "tests/test_support.h"
 
 namespace svrc {
 namespace {
 
+using testing::NodeRequest;
+using testing::WaitTerminal;
+
 using cli::RemoteClient;
 using testing::ServerProcess;
 using Clock = std::chrono::steady_clock;
 
-v1::SubmitJobRequest NodeRequest(const std::string& node, const std::string& name,
-                                 const std::string& request_id) {
-  v1::SubmitJobRequest r;
-  r.set_request_id(request_id);
-  r.mutable_file()->set_format(v1::NODE);
-  r.mutable_file()->set_name(name);
-  r.mutable_file()->set_data(node);
-  return r;
-}
 
-v1::Job WaitTerminal(RemoteClient& c, const std::string& id, double timeout_s = 120) {
-  const auto t0 = Clock::now();
-  absl::StatusOr<v1::Job> job;
-  while (std::chrono::duration<double>(Clock::now() - t0).count() < timeout_s) {
-    job = c.Get(id);
-    if (job.ok() && (job->state() == v1::SUCCEEDED || job->state() == v1::FAILED ||
-                     job->state() == v1::CANCELLED)) {
-      return *job;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ADD_FAILURE() << "job " << id << " did not finish: "
-                << (job.ok() ? v1::JobState_Name(job->state()) : job.status().ToString());
-  return job.ok() ? *job : v1::Job();
-}
 
 class DataDir {
  public:
@@ -69,7 +49,7 @@ TEST(PersistenceTest, KillNineLosesNothingAndServesFinishedResults) {
     ServerProcess server({"--workers=1"}, dir.path());
     ASSERT_TRUE(server.ok());
     RemoteClient c(server.address());
-    absl::StatusOr<v1::Job> a = c.Submit(NodeRequest(small, "a.node", "req-a"));
+    absl::StatusOr<v1::Job> a = c.Submit(NodeRequest(small, "req-a", "a.node"));
     ASSERT_TRUE(a.ok()) << a.status();
     done_id = a->job_id();
     ASSERT_EQ(WaitTerminal(c, done_id).state(), v1::SUCCEEDED);
@@ -78,12 +58,12 @@ TEST(PersistenceTest, KillNineLosesNothingAndServesFinishedResults) {
     done_bytes = fetched->bytes;
     // One long job occupies the only worker; three more wait behind it.
     absl::StatusOr<v1::Job> big =
-        c.Submit(NodeRequest(testing::RandomNodeFile(300000, 2), "big.node", "req-big"));
+        c.Submit(NodeRequest(testing::RandomNodeFile(300000, 2), "req-big", "big.node"));
     ASSERT_TRUE(big.ok()) << big.status();
     pending.push_back(big->job_id());
     for (int i = 0; i < 3; ++i) {
       absl::StatusOr<v1::Job> j = c.Submit(NodeRequest(testing::RandomNodeFile(1500, 10 + i),
-                                                       "q.node", "req-q" + std::to_string(i)));
+                                                       "req-q" + std::to_string(i), "q.node"));
       ASSERT_TRUE(j.ok()) << j.status();
       pending.push_back(j->job_id());
     }
@@ -107,7 +87,7 @@ TEST(PersistenceTest, KillNineLosesNothingAndServesFinishedResults) {
   ASSERT_TRUE(fetched.ok()) << fetched.status();
   EXPECT_EQ(fetched->bytes, done_bytes);
   // Its request id still deduplicates.
-  absl::StatusOr<v1::Job> again = c.Submit(NodeRequest(small, "a.node", "req-a"));
+  absl::StatusOr<v1::Job> again = c.Submit(NodeRequest(small, "req-a", "a.node"));
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_EQ(again->job_id(), done_id);
   // Every interrupted job runs to the end; its result is served and intact.
@@ -138,7 +118,7 @@ TEST(PersistenceTest, JobThatKillsTheServerTwiceEndsFailed) {
     ASSERT_TRUE(server.ok());
     RemoteClient c(server.address(), absl::Seconds(5));
     // The reply may or may not arrive before the worker kills the server.
-    c.Submit(NodeRequest(testing::RandomNodeFile(100, 3), "crash.node", "req-crash"), 1)
+    c.Submit(NodeRequest(testing::RandomNodeFile(100, 3), "req-crash", "crash.node"), 1)
         .IgnoreError();
     ASSERT_TRUE(server.WaitKilled(30)) << "attempt 1 did not crash the server";
   }
@@ -160,7 +140,7 @@ TEST(PersistenceTest, JobThatKillsTheServerTwiceEndsFailed) {
   EXPECT_NE(crashed.error().message().find("died 2 times"), std::string::npos)
       << crashed.error().message();
   // The server is alive and runs the next job.
-  absl::StatusOr<v1::Job> next = c.Submit(NodeRequest(testing::RandomNodeFile(500, 4), "ok.node", ""));
+  absl::StatusOr<v1::Job> next = c.Submit(NodeRequest(testing::RandomNodeFile(500, 4), "", "ok.node"));
   ASSERT_TRUE(next.ok()) << next.status();
   EXPECT_EQ(WaitTerminal(c, next->job_id()).state(), v1::SUCCEEDED);
   EXPECT_EQ(server.Terminate(30), 0);
@@ -175,7 +155,7 @@ TEST(PersistenceTest, GracefulRestartKeepsQueuedJobsQueued) {
     RemoteClient c(server.address());
     for (int i = 0; i < 3; ++i) {
       absl::StatusOr<v1::Job> j = c.Submit(
-          NodeRequest(testing::RandomNodeFile(i == 0 ? 300000 : 1000, 20 + i), "g.node", ""));
+          NodeRequest(testing::RandomNodeFile(i == 0 ? 300000 : 1000, 20 + i), "", "g.node"));
       ASSERT_TRUE(j.ok()) << j.status();
       ids.push_back(j->job_id());
     }

@@ -7,11 +7,15 @@
 
 #include "client/remote_client.h"
 #include "gtest/gtest.h"
+#include "tests/server/job_test_util.h"
 #include "tests/server/service_test_util.h"
 #include "tests/test_support.h"
 
 namespace svrc {
 namespace {
+
+using testing::NodeRequest;
+using testing::WaitTerminal;
 
 using cli::ClientSecurity;
 using cli::RemoteClient;
@@ -21,29 +25,7 @@ using Clock = std::chrono::steady_clock;
 constexpr char kAliceToken[] = "alice-0123456789abcdef0123456789";
 constexpr char kBobToken[] = "bob-fedcba9876543210fedcba987654";
 
-v1::SubmitJobRequest NodeRequest(const std::string& node, const std::string& request_id = "") {
-  v1::SubmitJobRequest r;
-  r.set_request_id(request_id);
-  r.mutable_file()->set_format(v1::NODE);
-  r.mutable_file()->set_name("points.node");
-  r.mutable_file()->set_data(node);
-  return r;
-}
 
-v1::Job WaitTerminal(RemoteClient& c, const std::string& id, double timeout_s = 120) {
-  const auto t0 = Clock::now();
-  absl::StatusOr<v1::Job> job;
-  while (std::chrono::duration<double>(Clock::now() - t0).count() < timeout_s) {
-    job = c.Get(id);
-    if (job.ok() && (job->state() == v1::SUCCEEDED || job->state() == v1::FAILED ||
-                     job->state() == v1::CANCELLED)) {
-      return *job;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ADD_FAILURE() << "job " << id << " did not finish";
-  return job.ok() ? *job : v1::Job();
-}
 
 class TempDir {
  public:
