@@ -202,6 +202,20 @@ Vec3 VectorArea(const std::vector<Vec3>& pts) {
   return 0.5 * s;
 }
 
+// Adds sign × (solid angle of the polygon fan pts[0], pts[i], pts[i+1] seen
+// from p) to *total, term by term. Van Oosterom & Strackee (1983):
+// tan(Ω/2) = det / denominator.
+void AddFanSolidAngle(const std::vector<Vec3>& pts, const Vec3& p, int sign, double* total) {
+  const Vec3 a = pts[0] - p;
+  for (size_t i = 1; i + 1 < pts.size(); ++i) {
+    const Vec3 b = pts[i] - p, c = pts[i + 1] - p;
+    const double la = Norm(a), lb = Norm(b), lc = Norm(c);
+    const double num = Dot(a, Cross(b, c));
+    const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
+    *total += sign * 2 * std::atan2(num, den);
+  }
+}
+
 FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet, double tol) {
   FacetGeom f;
   f.marker = facet.marker;
@@ -727,15 +741,7 @@ class Checker {
           if (l.outer == l.hole) continue;  // subdivision, or removed outer loop
           const int sign = (Dot(VectorArea(l.pts), normal[f]) > 0 ? 1 : -1) *
                            (l.hole ? -1 : 1) * orient[f];
-          const Vec3 a = l.pts[0] - p;
-          for (size_t i = 1; i + 1 < l.pts.size(); ++i) {
-            const Vec3 b = l.pts[i] - p, c = l.pts[i + 1] - p;
-            // Van Oosterom & Strackee (1983): tan(Ω/2) = det / denominator.
-            const double la = Norm(a), lb = Norm(b), lc = Norm(c);
-            const double num = Dot(a, Cross(b, c));
-            const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
-            total += sign * 2 * std::atan2(num, den);
-          }
+          AddFanSolidAngle(l.pts, p, sign, &total);
         }
       }
       return total / (4 * 3.14159265358979323846);
@@ -848,15 +854,7 @@ class Checker {
       for (const Loop& l : fg.loops) {
         if (l.outer == l.hole) continue;
         const int sign = (Dot(VectorArea(l.pts), out) > 0 ? 1 : -1) * (l.hole ? -1 : 1);
-        const Vec3 a = l.pts[0] - p;
-        for (size_t i = 1; i + 1 < l.pts.size(); ++i) {
-          const Vec3 b = l.pts[i] - p, c = l.pts[i + 1] - p;
-          // Van Oosterom & Strackee (1983): tan(Ω/2) = det / denominator.
-          const double la = Norm(a), lb = Norm(b), lc = Norm(c);
-          const double num = Dot(a, Cross(b, c));
-          const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
-          total += sign * 2 * std::atan2(num, den);
-        }
+        AddFanSolidAngle(l.pts, p, sign, &total);
       }
     }
     return total / (4 * 3.14159265358979323846);
