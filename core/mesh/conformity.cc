@@ -116,6 +116,36 @@ Box3 Expand(Box3 b, double d) {
   return b;
 }
 
+// ------------------------------------------------------- duplicate vertices
+
+// first[v] = the smallest input id with exactly v's coordinates (== on each
+// coordinate, so -0 and +0 are equal). The PLC readers/validator merge exact
+// duplicates into their first occurrence (docs/plc.md), so segments and
+// facets through a copy are checked as through the first occurrence. Ids
+// with a NaN coordinate map to themselves.
+std::vector<uint32_t> FirstOccurrences(const std::vector<Vec3>& pts) {
+  std::vector<uint32_t> first(pts.size());
+  std::iota(first.begin(), first.end(), 0u);
+  std::vector<uint32_t> order;
+  order.reserve(pts.size());
+  for (uint32_t i = 0; i < pts.size(); ++i) {
+    const Vec3& p = pts[i];
+    if (!std::isnan(p.x) && !std::isnan(p.y) && !std::isnan(p.z)) order.push_back(i);
+  }
+  auto less = [&](uint32_t i, uint32_t j) {
+    const Vec3 &a = pts[i], &b = pts[j];
+    if (a.x != b.x) return a.x < b.x;
+    if (a.y != b.y) return a.y < b.y;
+    if (a.z != b.z) return a.z < b.z;
+    return i < j;
+  };
+  std::sort(order.begin(), order.end(), less);
+  for (size_t k = 1; k < order.size(); ++k) {
+    if (pts[order[k]] == pts[order[k - 1]]) first[order[k]] = first[order[k - 1]];
+  }
+  return first;
+}
+
 // ------------------------------------------------------------- facet model
 
 struct Plane {
@@ -216,7 +246,9 @@ void AddFanSolidAngle(const std::vector<Vec3>& pts, const Vec3& p, int sign, dou
   }
 }
 
-FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet, double tol) {
+// `first`: FirstOccurrences(plc.vertices); loop ids are stored mapped.
+FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet,
+                     const std::vector<uint32_t>& first, double tol) {
   FacetGeom f;
   f.marker = facet.marker;
   std::vector<uint32_t> all;
@@ -255,8 +287,10 @@ FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet, double tol) {
   for (const auto& poly : facet.polygons) {
     if (poly.vertices.size() < 3) continue;
     Loop l;
-    l.ids = poly.vertices;
-    for (uint32_t v : poly.vertices) l.pts.push_back(plc.vertices[v]);
+    for (uint32_t v : poly.vertices) {
+      l.ids.push_back(first[v]);
+      l.pts.push_back(plc.vertices[v]);
+    }
     l.area = Norm(VectorArea(l.pts));
     f.loops.push_back(std::move(l));
   }
@@ -548,8 +582,9 @@ class Checker {
       scale = std::max({scale, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
     }
     tol_ = opt_.tolerance_ulps * kEps52 * scale;
+    first_ = FirstOccurrences(plc_->vertices);
     facets_.reserve(plc_->facets.size());
-    for (const auto& f : plc_->facets) facets_.push_back(BuildFacet(*plc_, f, tol_));
+    for (const auto& f : plc_->facets) facets_.push_back(BuildFacet(*plc_, f, first_, tol_));
     for (const FacetGeom& f : facets_) rep_->num_facets_checked += f.valid ? 1 : 0;
     Box3 all;
     for (const FacetGeom& f : facets_) {
@@ -961,9 +996,10 @@ class Checker {
     }
     for (const auto& poly_facet : plc_->facets) {
       for (const auto& poly : poly_facet.polygons) {
-        if (poly.vertices.size() == 2) {
-          inner_edges.push_back({std::min(poly.vertices[0], poly.vertices[1]),
-                                 std::max(poly.vertices[0], poly.vertices[1])});
+        if (poly.vertices.size() == 2 && poly.vertices[0] < first_.size() &&
+            poly.vertices[1] < first_.size()) {
+          const uint32_t a = first_[poly.vertices[0]], b = first_[poly.vertices[1]];
+          if (a != b) inner_edges.push_back({std::min(a, b), std::max(a, b)});
         }
       }
     }
@@ -1241,6 +1277,11 @@ class Checker {
     std::sort(order.begin(), order.end(), [&](uint32_t i, uint32_t j) {
       return less(P(i), P(j)) || (P(i) == P(j) && i < j);
     });
+    std::vector<uint8_t> used(nv, 0);
+    for (size_t t = 0; t < mesh_.tets.size(); ++t) {
+      if (!tet_ok_[t]) continue;
+      for (uint32_t v : mesh_.tets[t]) used[v] = 1;
+    }
     input_map_.assign(plc_->vertices.size(), kNone);
     for (size_t i = 0; i < plc_->vertices.size(); ++i) {
       const Vec3& p = plc_->vertices[i];
@@ -1250,6 +1291,14 @@ class Checker {
       }
       auto it = std::lower_bound(order.begin(), order.end(), p,
                                  [&](uint32_t v, const Vec3& q) { return less(P(v), q); });
+      // Several mesh vertices at p (e.g. a duplicated input vertex kept at
+      // both ids): the segment walk needs the one the tets use.
+      for (auto jt = it; jt != order.end() && P(*jt) == p; ++jt) {
+        if (used[*jt]) {
+          it = jt;
+          break;
+        }
+      }
       if (it == order.end() || !(P(*it) == p)) {
         Add(rep_, opt_, ViolationKind::kMissingInputVertex, {static_cast<int64_t>(i)},
             absl::StrFormat("input vertex %d (%.17g, %.17g, %.17g) is not a mesh vertex", i, p.x,
@@ -1513,6 +1562,7 @@ class Checker {
   std::vector<uint32_t> facet_stamp_;
   uint32_t query_ = 0;
   std::vector<uint32_t> input_map_;
+  std::vector<uint32_t> first_;  // FirstOccurrences(plc vertices)
   std::vector<uint32_t> adj_start_, adj_;
   // Cells of the facet arrangement (BuildCells).
   bool cells_known_ = false;
@@ -1608,7 +1658,10 @@ std::string ConformityReport::Summary() const {
 std::vector<std::array<uint32_t, 2>> ConformitySegments(const plc::Plc& plc) {
   std::vector<std::array<uint32_t, 2>> out;
   std::set<std::array<uint32_t, 2>> seen;
+  const std::vector<uint32_t> first = FirstOccurrences(plc.vertices);
   auto add = [&](uint32_t a, uint32_t b) {
+    if (a < first.size()) a = first[a];
+    if (b < first.size()) b = first[b];
     if (a == b) return;
     if (seen.insert({std::min(a, b), std::max(a, b)}).second) out.push_back({a, b});
   };

@@ -227,6 +227,62 @@ TEST(Conformity, RejectsBrokenSegmentChain) {
   EXPECT_EQ(r.violations[0].ids[0], 0);  // free segments come first
 }
 
+// The unit box whose corner (1,1,1) is given twice: vertex 8 is an exact
+// copy of vertex 7. Facet x = 1 and a free segment use the copy. The PLC
+// readers/validator merge 8 into 7; the mesh keeps both positions at their
+// input ids and its tets use only 7 (docs/conformity.md "Duplicate input
+// vertices").
+plc::Plc BoxWithDuplicateCorner() {
+  plc::Plc p = BoxPlc(kLo, kHi);
+  p.vertices.push_back(p.vertices[7]);
+  p.facets[1].polygons[0].vertices = {1, 3, 8, 5};  // x = 1
+  p.segments.push_back({0, 8, 9});                  // the main diagonal, through the copy
+  return p;
+}
+
+TEST(Conformity, DuplicateInputVertexMapsToItsFirstOccurrence) {
+  const plc::Plc p = BoxWithDuplicateCorner();
+  const TetMesh m = KuhnBoxMesh(p, 2);
+  ASSERT_EQ(m.positions[8], m.positions[7]);
+  for (const auto& t : m.tets) ASSERT_EQ(std::count(t.begin(), t.end(), 8u), 0);
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  EXPECT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_EQ(r.num_cells, 1u);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
+  // (0,8) = (0,7); facet x = 1's edges (3,8), (8,5) = (3,7), (7,5).
+  EXPECT_EQ(r.num_segments_checked, 13u);
+  ConformityOptions by_coordinates;
+  by_coordinates.input_vertices_first = false;
+  const ConformityReport rc = CheckConformity(p, m, by_coordinates);
+  EXPECT_TRUE(rc.ok()) << rc.Summary();
+
+  // The segment through the copy is still required: the 5-tet cube has no
+  // edge 0-7.
+  TetMesh five;
+  five.positions = p.vertices;
+  five.num_input_vertices = 9;
+  five.tets = {{1, 2, 4, 7}, {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}};
+  FixOrientation(&five);
+  testing::AssignBoxTriangles(p, &five);
+  const ConformityReport r5 = CheckConformity(p, five);
+  EXPECT_EQ(r5.Count(ViolationKind::kBrokenSegment), 1u) << r5.Summary();
+  EXPECT_EQ(r5.Count(ConformityCategory::kConformity), 1u) << r5.Summary();
+  EXPECT_EQ(r5.Count(ConformityCategory::kValidity) + r5.Count(ConformityCategory::kCoverage), 0u)
+      << r5.Summary();
+}
+
+TEST(Conformity, ConformitySegmentsMergeDuplicates) {
+  const plc::Plc p = BoxWithDuplicateCorner();
+  const auto segs = ConformitySegments(p);
+  ASSERT_EQ(segs.size(), 13u);
+  EXPECT_EQ(segs[0], (std::array<uint32_t, 2>{0, 7}));  // the free segment, mapped
+  for (const auto& s : segs) {
+    EXPECT_NE(s[0], 8u);
+    EXPECT_NE(s[1], 8u);
+  }
+}
+
 TEST(Conformity, RejectsOverlappingTetsWithUnchangedVolume) {
   const plc::Plc p = BoxPlc(kLo, kHi);
   TetMesh m = KuhnBoxMesh(p, 3);
