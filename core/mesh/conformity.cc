@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/geometry/predicates.h"
+#include "core/plc/polygon2d.h"
 
 namespace svrc::mesh {
 namespace {
@@ -90,7 +91,7 @@ class BoxGrid {
   }
   template <typename F>
   void ForCells(const Box3& b, F&& f) const {
-    int lo[3], hi[3];
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < 3; ++a) {
       lo[a] = CellOf(b.lo[a], a);
       hi[a] = CellOf(b.hi[a], a);
@@ -166,6 +167,7 @@ struct FacetGeom {
   bool valid = false;
   Plane plane;
   std::vector<Loop> loops;
+  std::vector<std::vector<uint8_t>> inside;  // inside[i][j]: loop i lies inside loop j
   double area = 0;
   Box3 box;
   int32_t marker = 0;
@@ -299,7 +301,8 @@ FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet,
   // Outer loops: not contained in another loop (all vertices inside or on it,
   // one strictly inside).
   const size_t nl = f.loops.size();
-  std::vector<std::vector<bool>> inside(nl, std::vector<bool>(nl, false));
+  std::vector<std::vector<uint8_t>>& inside = f.inside;
+  inside.assign(nl, std::vector<uint8_t>(nl, 0));
   for (size_t i = 0; i < nl; ++i) {
     for (size_t j = 0; j < nl; ++j) {
       if (i == j) continue;
@@ -334,6 +337,31 @@ FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet,
   }
   f.valid = true;
   return f;
+}
+
+// Triangulates the facet's region: every outer polygon (not itself a hole)
+// minus the outermost hole polygons inside it, by plc::TriangulatePolygon
+// (exact ear clipping with hole bridges in the projection that drops
+// plane.axis). Ids index `verts` (the PLC's vertices). False when some
+// polygon cannot be triangulated (self-intersecting loops).
+bool TriangulateRegion(const std::vector<Vec3>& verts, const FacetGeom& f,
+                       std::vector<std::array<uint32_t, 3>>* out) {
+  const size_t nl = f.loops.size();
+  auto is_hole = [&](size_t j) { return f.loops[j].hole && !f.loops[j].outer; };
+  for (size_t i = 0; i < nl; ++i) {
+    if (!f.loops[i].outer || f.loops[i].hole) continue;
+    std::vector<std::vector<uint32_t>> holes;
+    for (size_t j = 0; j < nl; ++j) {
+      if (!is_hole(j) || !f.inside[j][i]) continue;
+      bool outermost = true;
+      for (size_t k = 0; k < nl && outermost; ++k) {
+        outermost = k == j || !is_hole(k) || !f.inside[j][k];
+      }
+      if (outermost) holes.push_back(f.loops[j].ids);
+    }
+    if (!plc::TriangulatePolygon(verts, f.loops[i].ids, holes, f.plane.axis, out)) return false;
+  }
+  return true;
 }
 
 // --------------------------------------------------- 2D clipping for crossing
@@ -1476,8 +1504,206 @@ class Checker {
     return found;
   }
 
+  // ------------------------------------------------------------ crossings
+  //
+  // docs/conformity.md "Crossings". A tet crosses facet f when its interior
+  // meets the relative interior of f's region. The region is triangulated
+  // (TriangulateRegion); a tet with vertices strictly on both sides of f's
+  // plane crosses f iff its interior meets the interior of one of those
+  // triangles. Both are convex and the triangle lies in the plane, so they
+  // are disjoint iff a separating axis exists among (a) the edge lines of the
+  // triangle, tested on the tet's cross-section S with the plane, and (b) the
+  // tet's face planes (whose traces are S's edges) — the separating axis
+  // theorem for two convex polygons in the plane. Every sign is exact:
+  //   * S's vertices are the tet vertices on the plane ("O", with the
+  //     tolerance) and the crossing points x_ab of the tet edges ab whose
+  //     ends are strictly on either side ("X"). x_ab is never constructed:
+  //     its side of a line pq in the plane is the Plücker sign
+  //     -Orient3d(p, q, a, b) * sign(N[axis]) (a on the positive side, N the
+  //     plane's normal), exact when p, q lie on the plane.
+  //   * an O vertex's side of pq is Orient2dProjected; a triangle vertex's
+  //     side of a tet face plane is Orient3d.
+  // The slanted-feature tolerance: an O vertex within tol of the line pq, or
+  // a triangle vertex within tol of a face plane, counts as on it (both can
+  // only be off by the rounding of Steiner points on slanted features).
+
+  struct RegionMesh {
+    int state = 0;  // 0: not built, 1: built, -1: not triangulable
+    std::vector<std::array<uint32_t, 3>> tris;
+    std::vector<int8_t> orient;  // Orient2dProjected of each triangle
+    std::vector<Box3> boxes;     // expanded by tol
+    std::unique_ptr<BoxGrid> grid;
+    std::vector<uint32_t> stamp;
+    uint32_t query = 0;
+  };
+
+  RegionMesh& Region(size_t f) {
+    RegionMesh& rm = region_[f];
+    if (rm.state != 0) return rm;
+    const FacetGeom& fg = facets_[f];
+    rm.state = -1;
+    std::vector<std::array<uint32_t, 3>> tris;
+    if (!TriangulateRegion(plc_->vertices, fg, &tris)) return rm;
+    const std::vector<Vec3>& pv = plc_->vertices;
+    for (const auto& t : tris) {
+      const int o = geom::Orient2dProjected(pv[t[0]], pv[t[1]], pv[t[2]], fg.plane.axis);
+      if (o == 0) continue;  // no interior
+      Box3 b;
+      for (uint32_t v : t) b.Add(pv[v]);
+      rm.tris.push_back(t);
+      rm.orient.push_back(static_cast<int8_t>(o));
+      rm.boxes.push_back(Expand(b, tol_));
+    }
+    if (rm.tris.size() > 16) {
+      rm.grid = std::make_unique<BoxGrid>(Expand(fg.box, tol_), rm.tris.size(), 2, 64,
+                                          [&](size_t i) { return rm.boxes[i]; });
+      rm.stamp.assign(rm.tris.size(), kNone);
+    }
+    rm.state = 1;
+    return rm;
+  }
+
+  static double DistToLine(const Vec3& a, const Vec3& b, const Vec3& p) {
+    const Vec3 d = b - a;
+    return Norm(Cross(d, p - a)) / Norm(d);
+  }
+  static double DistToPlane(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p) {
+    const Vec3 n = Cross(b - a, c - a);
+    return std::fabs(Dot(n, p - a)) / Norm(n);
+  }
+
+  // A vertex of the cross-section: tet vertex i on the plane (j < 0), or the
+  // crossing point of the tet edge from vertex i (positive side) to vertex j
+  // (negative side).
+  struct SectionPoint {
+    int i, j;
+  };
+
+  // Side (+1 left, -1 right, 0 on) of section point s of tet q with respect
+  // to the line p->r of facet plane pl, in the projection dropping pl.axis;
+  // nsign = sign of the plane normal's axis component.
+  int SectionSide(const std::array<uint32_t, 4>& q, const SectionPoint& s, const Vec3& p,
+                  const Vec3& r, int axis, int nsign) const {
+    if (s.j < 0) {
+      const Vec3& o = P(q[s.i]);
+      const int side = geom::Orient2dProjected(p, r, o, axis);
+      if (side != 0 && tol_ > 0 && DistToLine(p, r, o) <= tol_) return 0;
+      return side;
+    }
+    return -geom::Orient3d(p, r, P(q[s.i]), P(q[s.j])) * nsign;
+  }
+
+  bool TetCrossesRegion(const FacetGeom& fg, RegionMesh& rm, const std::array<uint32_t, 4>& q,
+                        const int side[4], int nsign) {
+    const int st = geom::Orient3d(P(q[0]), P(q[1]), P(q[2]), P(q[3]));
+    if (st == 0) return false;  // no interior (reported as degenerate)
+    // Faces in kFace order have the opposite vertex on the side -st.
+    const int inner = -st;
+    SectionPoint sec[4];
+    int ns = 0;
+    for (int i = 0; i < 4; ++i) {
+      if (side[i] == 0) sec[ns++] = {i, -1};
+    }
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        if (side[i] > 0 && side[j] < 0) sec[ns++] = {i, j};
+      }
+    }
+    Box3 tb;
+    for (uint32_t v : q) tb.Add(P(v));
+    const std::vector<Vec3>& pv = plc_->vertices;
+    const int axis = fg.plane.axis;
+    auto separated = [&](size_t k) {
+      const auto& t = rm.tris[k];
+      // (a) an edge line of the triangle, S on its closed outer side.
+      for (int e = 0; e < 3; ++e) {
+        const Vec3 &a = pv[t[e]], &b = pv[t[(e + 1) % 3]];
+        bool out = true;
+        for (int m = 0; m < ns && out; ++m) {
+          out = SectionSide(q, sec[m], a, b, axis, nsign) * rm.orient[k] <= 0;
+        }
+        if (out) return true;
+      }
+      // (b) a face plane of the tet, the triangle on its closed outer side.
+      for (const auto& face : kFace) {
+        const Vec3 &a = P(q[face[0]]), &b = P(q[face[1]]), &c = P(q[face[2]]);
+        bool out = true;
+        for (int m = 0; m < 3 && out; ++m) {
+          const Vec3& x = pv[t[m]];
+          const int o = geom::Orient3d(a, b, c, x);
+          out = o != inner || (tol_ > 0 && DistToPlane(a, b, c, x) <= tol_);
+        }
+        if (out) return true;
+      }
+      return false;
+    };
+    auto overlaps = [&](size_t k) {
+      const Box3& b = rm.boxes[k];
+      for (int a = 0; a < 3; ++a) {
+        if (b.hi[a] < tb.lo[a] || tb.hi[a] < b.lo[a]) return false;
+      }
+      return true;
+    };
+    if (rm.grid == nullptr) {
+      for (size_t k = 0; k < rm.tris.size(); ++k) {
+        if (overlaps(k) && !separated(k)) return true;
+      }
+      return false;
+    }
+    bool crosses = false;
+    ++rm.query;
+    rm.grid->Query(tb, [&](uint32_t k) {
+      if (crosses || rm.stamp[k] == rm.query) return;
+      rm.stamp[k] = rm.query;
+      if (overlaps(k) && !separated(k)) crosses = true;
+    });
+    return crosses;
+  }
+
+  // Fallback for a facet whose polygons cannot be triangulated (not a valid
+  // PLC facet): the cross-section in floating point, clipped against every
+  // outer/hole polygon; crossing when the overlap exceeds 1e-9 x the
+  // section's area. Returns the overlap area (0 when not crossing).
+  double CrossingAreaByClipping(const FacetGeom& fg, const std::vector<std::vector<P2>>& loops2,
+                                const std::array<uint32_t, 4>& q, const int side[4]) const {
+    const int axis = fg.plane.axis;
+    std::vector<P2> sec;
+    for (int i = 0; i < 4; ++i) {
+      if (side[i] == 0) sec.push_back({U(P(q[i]), axis), V(P(q[i]), axis)});
+    }
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        if (side[i] * side[j] >= 0) continue;
+        const Vec3 &pi = P(q[i]), &pj = P(q[j]);
+        const double di = Dot(fg.plane.n, pi - fg.plane.a);
+        const double dj = Dot(fg.plane.n, pj - fg.plane.a);
+        const double s = di / (di - dj);
+        const Vec3 x = pi + s * (pj - pi);
+        sec.push_back({U(x, axis), V(x, axis)});
+      }
+    }
+    if (sec.size() < 3) return 0;
+    // Order counter-clockwise around the centroid (convex, <= 4 points).
+    P2 c{0, 0};
+    for (const P2& p : sec) c = {c[0] + p[0] / sec.size(), c[1] + p[1] / sec.size()};
+    std::sort(sec.begin(), sec.end(), [&](const P2& x, const P2& y) {
+      return std::atan2(x[1] - c[1], x[0] - c[0]) < std::atan2(y[1] - c[1], y[0] - c[0]);
+    });
+    const double sec_area = std::fabs(SignedArea2(sec));
+    if (sec_area == 0) return 0;
+    double overlap = 0;
+    for (size_t l = 0; l < fg.loops.size(); ++l) {
+      const Loop& lp = fg.loops[l];
+      if (lp.hole == lp.outer) continue;  // subdivision, or an outer loop removed
+      const double a = std::fabs(SignedArea2(ClipConvex(loops2[l], sec)));
+      overlap += lp.outer ? a : -a;
+    }
+    return overlap > 1e-9 * sec_area ? overlap / std::fabs(fg.plane.n[axis]) : 0;
+  }
+
   void CheckCrossings() {
     facet_crossed_.assign(facets_.size(), 0);
+    region_.resize(facets_.size());
     if (mesh_box_.Empty() || mesh_.tets.empty()) return;
     const BoxGrid& tet_grid = TetGrid();
     std::vector<uint32_t> stamp(mesh_.tets.size(), kNone);
@@ -1485,12 +1711,9 @@ class Checker {
       const FacetGeom& fg = facets_[f];
       if (!fg.valid || fg.area == 0) continue;
       const int axis = fg.plane.axis;
-      std::vector<std::vector<P2>> loops2(fg.loops.size());
-      for (size_t l = 0; l < fg.loops.size(); ++l) {
-        for (const Vec3& p : fg.loops[l].pts) loops2[l].push_back({U(p, axis), V(p, axis)});
-      }
-      // Projected areas scale 3D areas by |n[axis]|.
-      const double proj = std::fabs(fg.plane.n[axis]);
+      const int nsign = geom::Orient2dProjected(fg.plane.a, fg.plane.b, fg.plane.c, axis);
+      RegionMesh* rm = nullptr;  // built on the first candidate tet
+      std::vector<std::vector<P2>> loops2;  // for the fallback only
       tet_grid.Query(Expand(fg.box, tol_), [&](uint32_t t) {
         if (stamp[t] == f) return;
         stamp[t] = static_cast<uint32_t>(f);
@@ -1503,44 +1726,25 @@ class Checker {
           neg = neg || side[i] < 0;
         }
         if (!pos || !neg) return;
-        // Cross-section of the tet with the plane, projected.
-        std::vector<P2> sec;
-        for (int i = 0; i < 4; ++i) {
-          if (side[i] == 0) sec.push_back({U(P(q[i]), axis), V(P(q[i]), axis)});
-        }
-        for (int i = 0; i < 4; ++i) {
-          for (int j = i + 1; j < 4; ++j) {
-            if (side[i] * side[j] >= 0) continue;
-            const Vec3 &pi = P(q[i]), &pj = P(q[j]);
-            const double di = Dot(fg.plane.n, pi - fg.plane.a);
-            const double dj = Dot(fg.plane.n, pj - fg.plane.a);
-            const double s = di / (di - dj);
-            const Vec3 x = pi + s * (pj - pi);
-            sec.push_back({U(x, axis), V(x, axis)});
+        if (rm == nullptr) rm = &Region(f);
+        std::string how;
+        if (rm->state == 1 && nsign != 0) {
+          if (!TetCrossesRegion(fg, *rm, q, side, nsign)) return;
+        } else {
+          if (loops2.empty()) {
+            loops2.resize(fg.loops.size());
+            for (size_t l = 0; l < fg.loops.size(); ++l) {
+              for (const Vec3& p : fg.loops[l].pts) loops2[l].push_back({U(p, axis), V(p, axis)});
+            }
           }
+          const double area = CrossingAreaByClipping(fg, loops2, q, side);
+          if (area == 0) return;
+          how = absl::StrFormat(" (facet not triangulable: floating-point overlap area %.3g)", area);
         }
-        if (sec.size() < 3) return;
-        // Order counter-clockwise around the centroid (convex, <= 4 points).
-        P2 c{0, 0};
-        for (const P2& p : sec) c = {c[0] + p[0] / sec.size(), c[1] + p[1] / sec.size()};
-        std::sort(sec.begin(), sec.end(), [&](const P2& x, const P2& y) {
-          return std::atan2(x[1] - c[1], x[0] - c[0]) < std::atan2(y[1] - c[1], y[0] - c[0]);
-        });
-        const double sec_area = std::fabs(SignedArea2(sec));
-        if (sec_area == 0) return;
-        double overlap = 0;
-        for (size_t l = 0; l < fg.loops.size(); ++l) {
-          const Loop& lp = fg.loops[l];
-          if (lp.hole == lp.outer) continue;  // subdivision, or an outer loop removed
-          const double a = std::fabs(SignedArea2(ClipConvex(loops2[l], sec)));
-          overlap += lp.outer ? a : -a;
-        }
-        if (overlap > 1e-9 * sec_area) {
-          facet_crossed_[f] = 1;
-          Add(rep_, opt_, ViolationKind::kTetCrossesFacet, {t, static_cast<int64_t>(f)},
-              absl::StrFormat("tet %d crosses facet %d (overlap area %.3g)", t, f,
-                              overlap / proj));
-        }
+        facet_crossed_[f] = 1;
+        Add(rep_, opt_, ViolationKind::kTetCrossesFacet, {t, static_cast<int64_t>(f)},
+            absl::StrCat("tet ", t, " (", q[0], " ", q[1], " ", q[2], " ", q[3],
+                         ") crosses facet ", f, how));
       });
     }
   }
@@ -1559,6 +1763,7 @@ class Checker {
   std::unique_ptr<BoxGrid> facet_grid_;
   std::unique_ptr<BoxGrid> tet_grid_;
   std::vector<uint8_t> facet_crossed_;
+  std::vector<RegionMesh> region_;  // per facet, for the crossing test
   std::vector<uint32_t> facet_stamp_;
   uint32_t query_ = 0;
   std::vector<uint32_t> input_map_;

@@ -334,6 +334,105 @@ TEST(Conformity, RejectsTetsCrossingAFacetAndMissingVertices) {
   EXPECT_GT(r3.Count(ViolationKind::kTetCrossesFacet), 0u) << r3.Summary();
 }
 
+// One tet (a, b, c, d) (reoriented if needed) over the PLC's vertices, which
+// it does not use: for crossing tests only.
+TetMesh OneTet(const plc::Plc& p, Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+  TetMesh m;
+  m.positions = p.vertices;
+  m.num_input_vertices = static_cast<uint32_t>(p.vertices.size());
+  const uint32_t n = static_cast<uint32_t>(m.positions.size());
+  m.positions.insert(m.positions.end(), {a, b, c, d});
+  m.tets = {{n, n + 1, n + 2, n + 3}};
+  FixOrientation(&m);
+  return m;
+}
+
+plc::Plc Square(Vec3 o, double side) {
+  plc::Plc p;
+  p.vertices = {o, o + Vec3(side, 0, 0), o + Vec3(side, side, 0), o + Vec3(0, side, 0)};
+  plc::Facet f;
+  f.polygons.push_back({{0, 1, 2, 3}});
+  f.marker = 1;
+  p.facets.push_back(f);
+  return p;
+}
+
+TEST(Conformity, TetCrossingIsExactForASmallFacetInsideABigTet) {
+  // The facet's area is 1e-14 of the tet's cross-section: the float test
+  // (overlap > 1e-9 x section) missed it.
+  const plc::Plc p = Square(Vec3(0, 0, 0), 1e-4);
+  const TetMesh m = OneTet(p, Vec3(-1000, -1000, -1000), Vec3(1000, -1000, -1000),
+                           Vec3(0, 1000, -1000), Vec3(0, 0, 1000));
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kTetCrossesFacet), 1u) << r.Summary();
+  // Moved off the facet (the section no longer reaches it): not crossing.
+  const TetMesh far = OneTet(p, Vec3(-1000, -1000, -1000), Vec3(-1e-3, -1000, -1000),
+                             Vec3(-1e-3, 1000, -1000), Vec3(-1e-3, 0, 1000));
+  EXPECT_EQ(CheckConformity(p, far).Count(ViolationKind::kTetCrossesFacet), 0u);
+}
+
+TEST(Conformity, TetCrossingIsExactForTetsTouchingAFacetEdgeFarFromTheOrigin) {
+  // The square [1e6, 1e6+1] x [0, 1] at z = 0. Each tet has an edge on the
+  // square's edge x = 1e6+1 and its other two vertices on either side of the
+  // plane; the crossing point of their edge lies at x > 1e6+1 (exact: it is
+  // decided by Orient3d below), so the cross-section only touches the facet.
+  // The float test reported these as crossing (found by random search).
+  const double x1 = 1e6 + 1;
+  const plc::Plc p = Square(Vec3(1e6, 0, 0), 1);
+  struct Case {
+    double y0, y1;
+    Vec3 w, z;
+  };
+  const Case cases[] = {
+      {0.12373789188038692, 0.33994527787274942,
+       Vec3(1000001.005222292, 0.60081977052630275, 0.78628347109737573),
+       Vec3(1000001.0034015017, 0.70379206035348096, -0.96753020972015202)},
+      {0.85948142104889147, 0.33516369279978936,
+       Vec3(1000001.0001890856, 0.20181101345942198, 0.37713127437915916),
+       Vec3(1000000.9999880089, 0.32360006139835928, -1.0724562971835945)},
+      {0.12521831815411577, 0.31512640528734193,
+       Vec3(1000001.0047847524, 0.38102520355882774, 0.9954904121005469),
+       Vec3(1000000.9994138217, 0.57845029928409597, -0.16258456150024861)},
+  };
+  // Orient3d(e0, e1, w, z) has the sign of this reference when segment wz
+  // crosses z = 0 on the far side (x > x1) of the line e0 e1.
+  const Vec3 e0(x1, 0, 0), e1(x1, 1, 0);
+  const int outside = geom::Orient3d(e0, e1, Vec3(x1 + 1, 0.5, 1), Vec3(x1 + 1, 0.5, -1));
+  for (const Case& c : cases) {
+    ASSERT_EQ(geom::Orient3d(e0, e1, c.w, c.z), outside);
+    const TetMesh m = OneTet(p, Vec3(x1, c.y0, 0), Vec3(x1, c.y1, 0), c.w, c.z);
+    const ConformityReport r = CheckConformity(p, m);
+    EXPECT_EQ(r.Count(ViolationKind::kTetCrossesFacet), 0u) << r.Summary();
+    // Mirrored to the facet's side (x -> 2 x1 - x, exact here): crossing.
+    auto mirror = [&](Vec3 v) { return Vec3(x1 - (v.x - x1), v.y, v.z); };
+    const TetMesh mm = OneTet(p, Vec3(x1, c.y0, 0), Vec3(x1, c.y1, 0), mirror(c.w), mirror(c.z));
+    EXPECT_EQ(CheckConformity(p, mm).Count(ViolationKind::kTetCrossesFacet), 1u);
+  }
+}
+
+TEST(Conformity, TetCrossingKeepsTheSlantedTolerance) {
+  // The slanted triangle (1,0,0), (0,1,0), (0,0,1) and a tet with an edge on
+  // its boundary edge z = 0 between Steiner points that doubles cannot put on
+  // that edge, its other vertices on either side of the plane x+y+z = 1 and
+  // their edge crossing it beyond the boundary (z < 0): it touches the facet
+  // along the edge only.
+  plc::Plc p;
+  p.vertices = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  plc::Facet f;
+  f.polygons.push_back({{0, 1, 2}});
+  p.facets.push_back(f);
+  const Vec3 u(2.0 / 3, 1.0 / 3, 0), v(1.0 / 3, 2.0 / 3, 0);
+  ASSERT_NE(geom::Orient3d(p.vertices[0], p.vertices[1], p.vertices[2], u), 0);
+  // x+y+z = 1.3 and 0.5; their edge meets the plane at (0.55, 0.55, -0.1).
+  const TetMesh m = OneTet(p, u, v, Vec3(0.7, 0.7, -0.1), Vec3(0.3, 0.3, -0.1));
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_EQ(r.Count(ViolationKind::kTetCrossesFacet), 0u) << r.Summary();
+  // The same tet pushed across the edge into the facet (crossing point
+  // (0.45, 0.45, 0.1)) crosses it.
+  const TetMesh in = OneTet(p, u, v, Vec3(0.6, 0.6, 0.1), Vec3(0.2, 0.2, 0.1));
+  EXPECT_EQ(CheckConformity(p, in).Count(ViolationKind::kTetCrossesFacet), 1u);
+}
+
 TEST(Conformity, RejectsWrongMarkerDuplicatesAndBadIds) {
   const plc::Plc p = BoxPlc(kLo, kHi);
   {
