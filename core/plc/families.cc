@@ -264,9 +264,12 @@ Plc SkewLines(int n, const SkewLinesOptions& options) {
   auto t = [&](int i) { return 0.125 + 0.75 * double(i) / double(n - 1); };
   for (int i = 0; i < n; ++i) b.NewV({t(i), 0.5, 0.25});
   for (int i = 0; i < n; ++i) b.NewV({0.5, t(i), 0.75});
+  // Each line is a chain of n-1 segments between consecutive points (TetGen
+  // 1.5 aborts on input vertices lying inside an input segment; our reader
+  // would split one long segment into the same pieces).
   if (options.segments) {
-    b.Segment(0, n - 1, 1);
-    b.Segment(n, 2 * n - 1, 2);
+    for (int i = 0; i + 1 < n; ++i) b.Segment(i, i + 1, 1);
+    for (int i = 0; i + 1 < n; ++i) b.Segment(n + i, n + i + 1, 2);
   }
   if (options.bounding_box) b.Box({0, 0, 0}, {1, 1, 1}, kWallMarker);
   return b.Take();
@@ -285,6 +288,12 @@ Plc SegmentFacetAngle(double angle_deg) {
   const double a = angle_deg * kDeg;
   const uint32_t p = b.NewV({0.25, 0.5, 0});
   const uint32_t q = b.NewV({0.25 + 0.5 * std::cos(a), 0.5, 0.5 * std::sin(a)});
+  // The foot is the end of an in-facet segment pointing away (-x) from the
+  // free segment (angle 180° - angle: no second crease). TetGen 1.5 aborts
+  // (fillregion assertion) on a free segment ending at a bare interior point
+  // of a facet, and our reader has no 1-vertex polygons.
+  const uint32_t back = b.NewV({0.125, 0.5, 0});
+  b.plc().facets[0].polygons.push_back(Polygon{{p, back}});  // facets[0]: the floor
   b.Segment(p, q, 1);
   return b.Take();
 }

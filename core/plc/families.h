@@ -71,8 +71,9 @@ struct SkewLinesOptions {
   bool bounding_box = true;  // inside the unit box (else: only the lines)
 };
 // n >= 2 points on each of two orthogonal skew lines: (t, 1/2, 1/4) and
-// (1/2, t, 3/4), t = 1/8 + (3/4)·i/(n-1). Without segments and box this is a
-// point set whose Delaunay triangulation has Θ(n²) tetrahedra.
+// (1/2, t, 3/4), t = 1/8 + (3/4)·i/(n-1); with `segments`, each line is a
+// chain of n-1 free segments (markers 1 and 2). Without segments and box this
+// is a point set whose Delaunay triangulation has Θ(n²) tetrahedra.
 Plc SkewLines(int n, const SkewLinesOptions& options = {});
 
 // Crease families (issue #6). Both inside the unit box.
@@ -85,8 +86,11 @@ Plc SkewLines(int n, const SkewLinesOptions& options = {});
 // segment with min_angle = angle_deg.
 Plc CreaseFacetPair(double angle_deg);
 
-// A free segment from (1/4, 1/2, 0), an interior point of the floor z = 0,
-// rising at `angle_deg` to the floor in the x direction, length 1/2.
+// A free segment from (1/4, 1/2, 0) on the floor z = 0, rising at
+// `angle_deg` to the floor in the x direction, length 1/2. Its foot ends an
+// in-facet segment of the floor going to (1/8, 1/2, 0), away from it (the
+// pair makes 180° - angle_deg), so the segment-facet angle is the only
+// crease pair at the foot.
 Plc SegmentFacetAngle(double angle_deg);
 
 // k >= 2 quads around the hinge line (1/2, y, 1/2), y in [0,1], the i-th in

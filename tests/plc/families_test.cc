@@ -197,13 +197,14 @@ TEST(Families, NestedBoxesAndVolumeCube) {
 TEST(Families, SkewLines) {
   const Plc plc = SkewLines(50);
   EXPECT_EQ(plc.vertices.size(), 108u);
-  ASSERT_EQ(plc.segments.size(), 2u);
+  ASSERT_EQ(plc.segments.size(), 98u);  // two chains of 49
   const Prepared p = Prepare(plc);
   ASSERT_TRUE(p.ok);
-  // Each line is split at its 48 interior points.
-  ASSERT_EQ(p.fc.pieces_of_free_segment.size(), 2u);
-  EXPECT_EQ(p.fc.pieces_of_free_segment[0].size(), 49u);
-  EXPECT_EQ(p.fc.pieces_of_free_segment[1].size(), 49u);
+  ASSERT_EQ(p.fc.pieces_of_free_segment.size(), 98u);
+  EXPECT_EQ(p.fc.segments.size(), 98u + 12u);
+  size_t free_pieces = 0;
+  for (const FeatureSegment& s : p.fc.segments) free_pieces += s.is_free;
+  EXPECT_EQ(free_pieces, 98u);
   EXPECT_EQ(CountIsolated(p.fc), 0u);
   // Consecutive points on a line are disjoint features 0.75/49 apart (the
   // lines are 1/2 apart, 1/4 from the floor and the ceiling).
@@ -257,14 +258,17 @@ TEST(Families, SegmentFacetAngles) {
     ASSERT_TRUE(p.ok);
     const PointId foot = p.fc.point_of_vertex[plc.segments[0].a];
     const PointId tip = p.fc.point_of_vertex[plc.segments[0].b];
-    // The foot is an interior point of the floor (facet 0).
-    ASSERT_EQ(p.fc.points[foot].interior_of.size(), 1u);
-    EXPECT_EQ(p.fc.points[foot].interior_of[0], 0u);
+    // The foot ends an in-facet segment of the floor (facet 0).
+    const FeatureSegment* in_floor = Piece(p, plc, {0.25, 0.5, 0}, {0.125, 0.5, 0});
+    ASSERT_NE(in_floor, nullptr);
+    EXPECT_EQ(in_floor->facets, std::vector<FacetId>{0});
+    EXPECT_FALSE(in_floor->is_free);
     EXPECT_TRUE(p.fc.points[foot].crease);
     EXPECT_FALSE(p.fc.points[tip].crease);
     EXPECT_EQ(p.fc.NumCreasePoints(), 1u);
     EXPECT_EQ(p.fc.NumCreaseSegments(), 0u);
-    // The segment-facet angle is the only pair at the foot: a crease iff the
+    // The segment-facet angle is the smallest pair at the foot (the in-facet
+    // segment makes 180° - angle with the free one): a crease iff the
     // threshold (alpha - 1e-9 rad, creases.cc) exceeds it. Bracketing with
     // alpha = angle + 2e-9 rad and alpha = angle puts it within 1e-9 rad.
     const double rad = deg * kDeg;
