@@ -8,9 +8,10 @@
 // PLC. Inputs: files (corpus paths) and generated families
 // (core/plc/families.h). Prints a markdown table with svrc/tetgen ratios.
 //
-// Usage: svrc_plc_bench [flags] [FILE...]
-//   --families            add every generated family (families::StandardInputs)
-//   --family NAME         add one generated family (repeatable; --list shows names)
+// Usage: svrc_plc_bench [flags] INPUT...   (inputs run in the order given)
+//   FILE                  a PLC file (any format ReadPlcFile and tetgen read)
+//   family:NAME, --family NAME   one generated family (--list shows the names)
+//   families, --families  every generated family (families::StandardInputs)
 //   --radius-edge 2,1.414 bounds to run (svrc --radius-edge B, tetgen -pq<B>)
 //   --tools svrc,tetgen   which peers run
 //   --timeout 120         seconds per run (then SIGKILL: "timeout")
@@ -507,17 +508,19 @@ std::vector<double> ParseList(const std::string& s) {
 
 int Usage(const char* argv0) {
   std::fprintf(stderr,
-               "usage: %s [--families] [--family NAME]... [--radius-edge 2,1.414] "
-               "[--tools svrc,tetgen] [--timeout 120] [--mem-limit-mib 4096] [--svrc PATH] "
-               "[--tetgen PATH] [--workdir DIR] [--keep] [--list] [FILE...]\n",
+               "usage: %s [--radius-edge 2,1.414] [--tools svrc,tetgen] [--timeout 120] "
+               "[--mem-limit-mib 4096] [--svrc PATH] [--tetgen PATH] [--workdir DIR] [--keep] "
+               "[--list] INPUT...\n  INPUT: a PLC file, family:NAME (--family NAME), "
+               "families (--families)\n",
                argv0);
   return 2;
 }
 
 int Main(int argc, char** argv) {
   Options o;
-  std::vector<std::string> files, family_names;
-  bool all_families = false;
+  // Inputs in command-line order: a file path, "family:NAME" or "families"
+  // (every generated family).
+  std::vector<std::string> specs;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -528,9 +531,9 @@ int Main(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--families") {
-      all_families = true;
+      specs.push_back("families");
     } else if (a == "--family") {
-      family_names.push_back(value());
+      specs.push_back("family:" + value());
     } else if (a == "--radius-edge") {
       o.bounds = ParseList(value());
     } else if (a == "--tools") {
@@ -561,34 +564,34 @@ int Main(int argc, char** argv) {
       std::fprintf(stderr, "unknown flag %s\n", a.c_str());
       return Usage(argv[0]);
     } else {
-      files.push_back(a);
+      specs.push_back(a);
     }
   }
   if (o.bounds.empty()) return Usage(argv[0]);
 
   std::vector<Input> inputs;
-  for (const std::string& f : files) {
-    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(f);
-    if (!plc.ok()) {
-      std::fprintf(stderr, "cannot read %s: %s\n", f.c_str(), plc.status().ToString().c_str());
-      return 1;
-    }
-    inputs.push_back(Input{Label(f), fs::absolute(f), *std::move(plc), 0});
-  }
-  if (all_families || !family_names.empty()) {
-    for (GeneratedInput& g : plc::families::StandardInputs()) {
-      if (!all_families &&
-          std::find(family_names.begin(), family_names.end(), g.name) == family_names.end()) {
-        continue;
+  std::vector<GeneratedInput> generated = plc::families::StandardInputs();
+  for (const std::string& spec : specs) {
+    if (spec == "families") {
+      for (const GeneratedInput& g : generated) {
+        inputs.push_back(Input{g.name, {}, g.plc, g.max_volume});
       }
-      family_names.erase(std::remove(family_names.begin(), family_names.end(), g.name),
-                         family_names.end());
-      inputs.push_back(Input{g.name, {}, std::move(g.plc), g.max_volume});
-    }
-    for (const std::string& n : family_names) {
-      if (all_families) break;
-      std::fprintf(stderr, "unknown family %s (see --list)\n", n.c_str());
-      return 2;
+    } else if (spec.rfind("family:", 0) == 0) {
+      const std::string name = spec.substr(7);
+      auto it = std::find_if(generated.begin(), generated.end(),
+                             [&](const GeneratedInput& g) { return g.name == name; });
+      if (it == generated.end()) {
+        std::fprintf(stderr, "unknown family %s (see --list)\n", name.c_str());
+        return 2;
+      }
+      inputs.push_back(Input{it->name, {}, it->plc, it->max_volume});
+    } else {
+      absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(spec);
+      if (!plc.ok()) {
+        std::fprintf(stderr, "cannot read %s: %s\n", spec.c_str(), plc.status().ToString().c_str());
+        return 1;
+      }
+      inputs.push_back(Input{Label(spec), fs::absolute(spec), *std::move(plc), 0});
     }
   }
   if (inputs.empty()) return Usage(argv[0]);
