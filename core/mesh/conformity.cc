@@ -237,14 +237,18 @@ Vec3 VectorArea(const std::vector<Vec3>& pts) {
 // Adds sign × (solid angle of the polygon fan pts[0], pts[i], pts[i+1] seen
 // from p) to *total, term by term. Van Oosterom & Strackee (1983):
 // tan(Ω/2) = det / denominator.
+void AddTriangleSolidAngle(const Vec3& pa, const Vec3& pb, const Vec3& pc, const Vec3& p,
+                           int sign, double* total) {
+  const Vec3 a = pa - p, b = pb - p, c = pc - p;
+  const double la = Norm(a), lb = Norm(b), lc = Norm(c);
+  const double num = Dot(a, Cross(b, c));
+  const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
+  *total += sign * 2 * std::atan2(num, den);
+}
+
 void AddFanSolidAngle(const std::vector<Vec3>& pts, const Vec3& p, int sign, double* total) {
-  const Vec3 a = pts[0] - p;
   for (size_t i = 1; i + 1 < pts.size(); ++i) {
-    const Vec3 b = pts[i] - p, c = pts[i + 1] - p;
-    const double la = Norm(a), lb = Norm(b), lc = Norm(c);
-    const double num = Dot(a, Cross(b, c));
-    const double den = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
-    *total += sign * 2 * std::atan2(num, den);
+    AddTriangleSolidAngle(pts[0], pts[i], pts[i + 1], p, sign, total);
   }
 }
 
@@ -626,6 +630,7 @@ class Checker {
       return facets_[i].valid ? Expand(facets_[i].box, tol_) : Box3();
     });
     facet_stamp_.assign(facets_.size(), kNone);
+    region_.resize(facets_.size());
   }
 
   // Calls f(facet index) for every valid facet containing the triangle abc
@@ -866,21 +871,35 @@ class Checker {
 
   // ------------------------------------------------ cells of the facet arrangement
   //
-  // docs/conformity.md "Cells of the facet arrangement". Each valid facet has
-  // two sides (nodes 2f: Orient3d(a,b,c,x) > 0, 2f+1: < 0). Around every
-  // polygon edge the facets' half-planes ("wings") are sorted by angle with
-  // exact Orient3d; consecutive wings bound one wedge, so the facing sides
-  // belong to the same cell: union them. Components are shells; a shell with
-  // positive outward volume is the outer boundary of one bounded cell, a
-  // negative one bounds a cell from inside (the unbounded cell or a cavity)
-  // and belongs to the innermost positive shell containing a point of it.
+  // docs/conformity.md "Cells of the facet arrangement". The region of each
+  // valid facet is triangulated (TriangulateRegion) with every edge of the
+  // complex that lies inside it inserted as a constraint, and split into
+  // *pieces*: the components of its triangles across edges that are not
+  // constraints. Each piece has two sides (nodes 2p: Orient3d(a,b,c,x) > 0
+  // of its facet's plane, 2p+1: < 0), and each side lies in one cell. Around
+  // every edge bounding a piece the pieces' half-planes ("wings") are sorted
+  // by angle with exact Orient3d; consecutive wings bound one wedge, so the
+  // facing sides belong to the same cell: union them. Components are shells;
+  // a shell with positive outward volume is the outer boundary of one bounded
+  // cell, a negative one bounds a cell from inside (the unbounded cell or a
+  // cavity) and belongs to the innermost positive shell containing a point
+  // of it.
+
+  struct Piece {
+    uint32_t facet = 0;
+    std::vector<std::array<uint32_t, 3>> tris;  // PLC vertex ids
+    std::vector<int8_t> up;                     // Orient3d(tri, a + n·L) (normal vs n)
+    double area = 0;
+  };
 
   static int Sgn(double x) { return x > 0 ? 1 : (x < 0 ? -1 : 0); }
 
+  // A point well off facet fg's plane on the side its unit normal n points to.
+  Vec3 AbovePlane(const FacetGeom& fg) const { return fg.plane.a + fg.plane.n * cell_len_; }
+
   // Orient3d(a,b,c,x) > 0 lies along sigma_[f] * n.
   int PlaneSigma(const FacetGeom& fg) const {
-    const Vec3 y = fg.plane.a + fg.plane.n * cell_len_;
-    return geom::Orient3d(fg.plane.a, fg.plane.b, fg.plane.c, y);
+    return geom::Orient3d(fg.plane.a, fg.plane.b, fg.plane.c, AbovePlane(fg));
   }
 
   uint32_t Find(std::vector<uint32_t>& uf, uint32_t x) const {
@@ -888,19 +907,22 @@ class Checker {
     return x;
   }
 
-  // A point strictly inside facet f's region (off every loop), or false.
-  bool FacetInteriorPoint(const FacetGeom& fg, Vec3* out) const {
-    const int axis = fg.plane.axis;
-    for (const Loop& l : fg.loops) {
-      if (!l.outer || l.hole) continue;
-      for (size_t i = 1; i + 1 < l.pts.size(); ++i) {
-        const Vec3 g = (l.pts[0] + l.pts[i] + l.pts[i + 1]) / 3.0;
-        bool ok = InFacetRegion(fg, g);
-        for (const Loop& m : fg.loops) ok = ok && PointInLoop(m.pts, g, axis) != 0;
-        if (ok) {
-          *out = g;
-          return true;
-        }
+  const Vec3& PV(uint32_t v) const { return plc_->vertices[v]; }
+
+  // A point strictly inside piece pc (strictly inside one of its triangles,
+  // exact), or false.
+  bool PieceInteriorPoint(const Piece& pc, Vec3* out) const {
+    const int axis = facets_[pc.facet].plane.axis;
+    for (const auto& t : pc.tris) {
+      const Vec3 g = (PV(t[0]) + PV(t[1]) + PV(t[2])) / 3.0;
+      const int o = geom::Orient2dProjected(PV(t[0]), PV(t[1]), PV(t[2]), axis);
+      bool in = o != 0;
+      for (int k = 0; k < 3 && in; ++k) {
+        in = geom::Orient2dProjected(PV(t[k]), PV(t[(k + 1) % 3]), g, axis) == o;
+      }
+      if (in) {
+        *out = g;
+        return true;
       }
     }
     return false;
@@ -910,14 +932,14 @@ class Checker {
   double ShellWinding(size_t s, const Vec3& p) const {
     double total = 0;
     for (uint32_t node : shell_nodes_[s]) {
-      const uint32_t f = node / 2;
+      const Piece& pc = pieces_[node / 2];
       const int side = node % 2 == 0 ? 1 : -1;
-      const FacetGeom& fg = facets_[f];
-      const Vec3 out = -(side * facet_sigma_[f]) * fg.plane.n;
-      for (const Loop& l : fg.loops) {
-        if (l.outer == l.hole) continue;
-        const int sign = (Dot(VectorArea(l.pts), out) > 0 ? 1 : -1) * (l.hole ? -1 : 1);
-        AddFanSolidAngle(l.pts, p, sign, &total);
+      // The outward normal is -side * sigma * n; a triangle's normal has the
+      // direction up * n.
+      const int out = -side * facet_sigma_[pc.facet];
+      for (size_t k = 0; k < pc.tris.size(); ++k) {
+        const auto& t = pc.tris[k];
+        AddTriangleSolidAngle(PV(t[0]), PV(t[1]), PV(t[2]), p, pc.up[k] * out, &total);
       }
     }
     return total / (4 * 3.14159265358979323846);
@@ -933,15 +955,15 @@ class Checker {
 
   // The cell containing p (a point on no facet): the positive shell of least
   // volume whose winding number at p is 1, or the unbounded cell. -1 when p
-  // is (nearly) on a facet. `skip_facet`: shells holding a side of this facet
+  // is (nearly) on a facet. `skip_piece`: shells holding a side of this piece
   // are not asked (p lies on it).
-  int32_t LocateCell(const Vec3& p, uint32_t skip_facet = kNone) const {
+  int32_t LocateCell(const Vec3& p, uint32_t skip_piece = kNone) const {
     int32_t best = num_bounded_cells_;
     for (size_t s = 0; s < shell_nodes_.size(); ++s) {
       const int32_t c = shell_cell_of_positive_[s];
       if (c < 0) continue;
-      if (skip_facet != kNone && (node_shell_[2 * skip_facet] == s ||
-                                  node_shell_[2 * skip_facet + 1] == s)) {
+      if (skip_piece != kNone && (node_shell_[2 * skip_piece] == s ||
+                                  node_shell_[2 * skip_piece + 1] == s)) {
         continue;
       }
       const int in = ShellInside(s, p);
@@ -951,6 +973,210 @@ class Checker {
       }
     }
     return best;
+  }
+
+  static uint64_t EdgeKey(uint32_t a, uint32_t b) {
+    return uint64_t{std::min(a, b)} << 32 | std::max(a, b);
+  }
+
+  // Splits every facet's triangulated region into pieces (pieces_,
+  // facet_pieces_) and collects the wings of the pieces' boundary edges.
+  // False (with cells_reason_) when the arrangement is outside what this
+  // handles.
+  struct Wing {
+    uint64_t key;
+    uint32_t piece;
+    uint32_t q;  // vertex of the piece's triangle on the edge: its interior side
+  };
+  bool BuildPieces(const std::vector<uint8_t>& present, std::vector<Wing>* wings) {
+    const size_t nf = facets_.size();
+    const std::vector<Vec3>& pv = plc_->vertices;
+    Box3 vbox;
+    for (const Vec3& p : pv) vbox.Add(p);
+    const BoxGrid vgrid(vbox, pv.size(), 2, 64, [&](size_t i) {
+      Box3 b;
+      if (first_[i] == i) b.Add(pv[i]);
+      return b;
+    });
+    // Every polygon edge of every facet, split at the vertices lying exactly
+    // inside it (as the PLC validator does: T-junctions are legal), gives the
+    // elementary edges. Per facet: the elementary edges of its outer/hole
+    // polygons (bnd) and the vertices inside them (bnd_pts).
+    std::vector<uint64_t> elem;
+    std::vector<std::vector<uint64_t>> bnd(nf);
+    std::vector<std::vector<uint32_t>> bnd_pts(nf);
+    std::vector<uint32_t> inner;
+    auto split = [&](uint32_t a, uint32_t b, std::vector<uint64_t>* out, std::vector<uint32_t>* pts) {
+      const Vec3 &pa = pv[a], &pb = pv[b];
+      const Vec3 d = pb - pa;
+      const int ax = geom::DominantAxis(d);
+      const double lo = std::min(pa[ax], pb[ax]), hi = std::max(pa[ax], pb[ax]);
+      Box3 q;
+      q.Add(pa);
+      q.Add(pb);
+      inner.clear();
+      vgrid.Query(q, [&](uint32_t m) {
+        if (m == a || m == b || !(pv[m][ax] > lo && pv[m][ax] < hi)) return;
+        for (int k = 0; k < 3; ++k) {
+          if (geom::Orient2dProjected(pa, pb, pv[m], k) != 0) return;
+        }
+        inner.push_back(m);
+      });
+      std::sort(inner.begin(), inner.end(), [&](uint32_t x, uint32_t y) {
+        return pa[ax] < pb[ax] ? pv[x][ax] < pv[y][ax] : pv[x][ax] > pv[y][ax];
+      });
+      inner.erase(std::unique(inner.begin(), inner.end()), inner.end());
+      uint32_t prev = a;
+      for (uint32_t m : inner) {
+        out->push_back(EdgeKey(prev, m));
+        if (pts != nullptr) pts->push_back(m);
+        prev = m;
+      }
+      out->push_back(EdgeKey(prev, b));
+    };
+    for (size_t f = 0; f < nf; ++f) {
+      const FacetGeom& fg = facets_[f];
+      for (const Loop& l : fg.loops) {
+        const bool boundary = l.outer != l.hole;
+        for (size_t i = 0, n = l.ids.size(); i < n; ++i) {
+          const uint32_t u = l.ids[i], v = l.ids[(i + 1) % n];
+          if (u == v) continue;
+          if (boundary && present[f]) {
+            split(u, v, &bnd[f], &bnd_pts[f]);
+          } else {
+            split(u, v, &elem, nullptr);
+          }
+        }
+      }
+      for (const auto& poly : plc_->facets[f].polygons) {
+        if (poly.vertices.size() != 2 || poly.vertices[0] >= pv.size() ||
+            poly.vertices[1] >= pv.size()) {
+          continue;
+        }
+        const uint32_t u = first_[poly.vertices[0]], v = first_[poly.vertices[1]];
+        if (u != v) split(u, v, &elem, nullptr);
+      }
+      std::sort(bnd[f].begin(), bnd[f].end());
+      bnd[f].erase(std::unique(bnd[f].begin(), bnd[f].end()), bnd[f].end());
+      elem.insert(elem.end(), bnd[f].begin(), bnd[f].end());
+    }
+    std::sort(elem.begin(), elem.end());
+    elem.erase(std::unique(elem.begin(), elem.end()), elem.end());
+    // Elementary edges lying in a facet's region (not on its boundary): they
+    // split it. In a valid PLC such an edge lies in the facet's closed region
+    // (its endpoints on the plane) and its open part is interior or on the
+    // boundary; the midpoint decides.
+    std::vector<std::vector<uint64_t>> cuts(nf);
+    for (uint64_t e : elem) {
+      const uint32_t a = static_cast<uint32_t>(e >> 32), b = static_cast<uint32_t>(e);
+      const Vec3 mid = (pv[a] + pv[b]) / 2.0;
+      Box3 q;
+      q.Add(mid);
+      ++query_;
+      facet_grid_->Query(q, [&](uint32_t g) {
+        if (facet_stamp_[g] == query_ || !present[g]) return;
+        facet_stamp_[g] = query_;
+        if (std::binary_search(bnd[g].begin(), bnd[g].end(), e)) return;
+        const FacetGeom& gg = facets_[g];
+        if (SideOf(gg.plane, pv[a], tol_) != 0 || SideOf(gg.plane, pv[b], tol_) != 0) return;
+        if (!InFacetRegion(gg, mid) || !InFacetRegion(gg, pv[a]) || !InFacetRegion(gg, pv[b])) {
+          return;
+        }
+        cuts[g].push_back(e);
+      });
+    }
+    struct EdgeRec {
+      uint64_t key;
+      uint32_t tri;
+      uint8_t local;  // edge local = (t[local], t[local+1]), opposite t[local+2]
+      bool operator<(const EdgeRec& o) const {
+        return key != o.key ? key < o.key : (tri != o.tri ? tri < o.tri : local < o.local);
+      }
+    };
+    for (size_t f = 0; f < nf; ++f) {
+      if (!present[f]) continue;
+      const FacetGeom& fg = facets_[f];
+      const RegionMesh& rm = Region(f);
+      if (rm.state != 1) {
+        cells_reason_ = absl::StrCat("facet ", f, "'s polygons cannot be triangulated");
+        return false;
+      }
+      std::vector<std::array<uint32_t, 3>> tris = rm.tris;
+      std::vector<uint64_t>& cut = cuts[f];
+      std::sort(cut.begin(), cut.end());
+      cut.erase(std::unique(cut.begin(), cut.end()), cut.end());
+      if (!cut.empty() || !bnd_pts[f].empty()) {
+        std::vector<uint32_t> pts = bnd_pts[f];
+        std::vector<std::array<uint32_t, 2>> segs;
+        for (uint64_t e : cut) {
+          const uint32_t a = static_cast<uint32_t>(e >> 32), b = static_cast<uint32_t>(e);
+          pts.push_back(a);
+          pts.push_back(b);
+          segs.push_back({a, b});
+        }
+        std::sort(pts.begin(), pts.end());
+        pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+        if (!plc::InsertConstraints(pv, fg.plane.axis, pts, segs, &tris)) {
+          cells_reason_ = absl::StrCat("facet ", f, ": the edges lying in it cannot be inserted");
+          return false;
+        }
+      }
+      // Triangle adjacency; pieces = components across non-constraint edges.
+      std::vector<EdgeRec> er;
+      er.reserve(3 * tris.size());
+      for (uint32_t t = 0; t < tris.size(); ++t) {
+        for (uint8_t k = 0; k < 3; ++k) er.push_back({EdgeKey(tris[t][k], tris[t][(k + 1) % 3]), t, k});
+      }
+      std::sort(er.begin(), er.end());
+      std::vector<uint32_t> uf(tris.size());
+      std::iota(uf.begin(), uf.end(), 0u);
+      for (size_t i = 0; i < er.size();) {
+        size_t j = i;
+        while (j < er.size() && er[j].key == er[i].key) ++j;
+        const bool is_cut = std::binary_search(cut.begin(), cut.end(), er[i].key);
+        if (j - i > 2) {
+          cells_reason_ = absl::StrCat("facet ", f, ": a triangulation edge in 3 triangles");
+          return false;
+        }
+        if (j - i == 1 && !std::binary_search(bnd[f].begin(), bnd[f].end(), er[i].key)) {
+          // The region's boundary must be made of its polygons' elementary
+          // edges, or other facets would not find the same edge keys.
+          cells_reason_ = absl::StrCat("facet ", f, "'s boundary does not match its polygon edges");
+          return false;
+        }
+        if (j - i == 2 && !is_cut) uf[Find(uf, er[i].tri)] = Find(uf, er[i + 1].tri);
+        i = j;
+      }
+      std::vector<uint32_t> piece_of(tris.size(), kNone);
+      const Vec3 above = AbovePlane(fg);
+      for (uint32_t t = 0; t < tris.size(); ++t) {
+        const uint32_t r = Find(uf, t);
+        if (piece_of[r] == kNone) {
+          piece_of[r] = static_cast<uint32_t>(pieces_.size());
+          facet_pieces_[f].push_back(piece_of[r]);
+          pieces_.emplace_back();
+          pieces_.back().facet = static_cast<uint32_t>(f);
+        }
+        piece_of[t] = piece_of[r];
+        Piece& pc = pieces_[piece_of[t]];
+        const auto& tr = tris[t];
+        pc.tris.push_back(tr);
+        pc.up.push_back(static_cast<int8_t>(geom::Orient3d(PV(tr[0]), PV(tr[1]), PV(tr[2]), above)));
+        pc.area += 0.5 * Norm(Cross(PV(tr[1]) - PV(tr[0]), PV(tr[2]) - PV(tr[0])));
+      }
+      for (size_t i = 0; i < er.size();) {
+        size_t j = i;
+        while (j < er.size() && er[j].key == er[i].key) ++j;
+        if (j - i == 1 || std::binary_search(cut.begin(), cut.end(), er[i].key)) {
+          for (size_t k = i; k < j; ++k) {
+            const auto& tr = tris[er[k].tri];
+            wings->push_back({er[k].key, piece_of[er[k].tri], tr[(er[k].local + 2) % 3]});
+          }
+        }
+        i = j;
+      }
+    }
+    return true;
   }
 
   // Builds the cells; leaves cells_known_ false (with a reason) when the
@@ -963,137 +1189,44 @@ class Checker {
     cell_origin_ = plc_box.Center();
     cell_len_ = std::max(1.0, Norm(plc_box.hi - plc_box.lo));
     facet_sigma_.assign(nf, 0);
+    facet_pieces_.assign(nf, {});
     std::vector<uint8_t> present(nf, 0);
-    struct Wing {
-      std::array<uint32_t, 2> key;
-      uint32_t facet;
-      Vec3 q;  // a point of the facet strictly on its interior side of the edge
-    };
-    std::vector<Wing> wings;
-    std::vector<std::array<uint32_t, 2>> inner_edges;  // subdivision loops, 2-vertex polygons
     for (size_t f = 0; f < nf; ++f) {
       const FacetGeom& fg = facets_[f];
       if (!fg.valid) return cells_reason_ = "an invalid facet", void();
       int outers = 0;
       for (const Loop& l : fg.loops) outers += l.outer && !l.hole ? 1 : 0;
       if (outers == 0) continue;  // nothing left of the facet
-      if (outers > 1) return cells_reason_ = "a facet with several outer polygons", void();
       present[f] = 1;
       facet_sigma_[f] = PlaneSigma(fg);
       if (facet_sigma_[f] == 0) return cells_reason_ = "a degenerate facet plane", void();
-      const int axis = fg.plane.axis;
-      for (const Loop& l : fg.loops) {
-        const size_t n = l.ids.size();
-        if (l.outer && l.hole) continue;
-        if (!l.outer && !l.hole) {
-          for (size_t i = 0; i < n; ++i) {
-            const uint32_t u = l.ids[i], v = l.ids[(i + 1) % n];
-            inner_edges.push_back({std::min(u, v), std::max(u, v)});
-          }
-          continue;
-        }
-        double area2 = 0;
-        for (size_t i = 0; i < n; ++i) {
-          const Vec3 &p = l.pts[i], &r = l.pts[(i + 1) % n];
-          area2 += U(p, axis) * V(r, axis) - U(r, axis) * V(p, axis);
-        }
-        const int m = Sgn(area2) * (l.hole ? -1 : 1);
-        if (m == 0) return cells_reason_ = "a degenerate facet polygon", void();
-        for (size_t i = 0; i < n; ++i) {
-          const uint32_t u = l.ids[i], v = l.ids[(i + 1) % n];
-          if (u == v) continue;
-          const Vec3 &pu = l.pts[i], &pv = l.pts[(i + 1) % n];
-          // The facet lies left of u->v (projected) when m > 0: any facet
-          // vertex strictly on that side represents the half-plane.
-          bool found = false;
-          Vec3 q;
-          for (const Loop& k : fg.loops) {
-            for (const Vec3& w : k.pts) {
-              if (geom::Orient2dProjected(pu, pv, w, axis) * m > 0) {
-                q = w;
-                found = true;
-                break;
-              }
-            }
-            if (found) break;
-          }
-          if (!found) return cells_reason_ = "a facet edge with no facet point beside it", void();
-          wings.push_back({{std::min(u, v), std::max(u, v)}, static_cast<uint32_t>(f), q});
-        }
-      }
     }
-    for (const auto& poly_facet : plc_->facets) {
-      for (const auto& poly : poly_facet.polygons) {
-        if (poly.vertices.size() == 2 && poly.vertices[0] < first_.size() &&
-            poly.vertices[1] < first_.size()) {
-          const uint32_t a = first_[poly.vertices[0]], b = first_[poly.vertices[1]];
-          if (a != b) inner_edges.push_back({std::min(a, b), std::max(a, b)});
-        }
-      }
-    }
+    std::vector<Wing> wings;
+    if (!BuildPieces(present, &wings)) return;
     std::sort(wings.begin(), wings.end(), [](const Wing& a, const Wing& b) {
-      return a.key != b.key ? a.key < b.key : a.facet < b.facet;
+      return a.key != b.key ? a.key < b.key : (a.piece != b.piece ? a.piece < b.piece : a.q < b.q);
     });
-    // An edge inside a facet that other facets end on splits that facet's
-    // sides into pieces: not handled.
-    for (const auto& e : inner_edges) {
-      auto it = std::lower_bound(wings.begin(), wings.end(), e,
-                                 [](const Wing& w, const std::array<uint32_t, 2>& k) {
-                                   return w.key < k;
-                                 });
-      if (it != wings.end() && it->key == e) {
-        return cells_reason_ = "a facet whose interior segment is another facet's edge", void();
-      }
-    }
-    // A facet edge lying on another facet (not as that facet's own polygon
-    // edge) would split that facet's sides into pieces: not handled. In a
-    // valid PLC such an edge lies inside the other facet's closed region, so
-    // its midpoint does.
-    for (size_t i = 0; i < wings.size();) {
-      size_t j = i;
-      while (j < wings.size() && wings[j].key == wings[i].key) ++j;
-      const Vec3 u = plc_->vertices[wings[i].key[0]], v = plc_->vertices[wings[i].key[1]];
-      const Vec3 mid = (u + v) / 2.0;
-      Box3 q;
-      q.Add(mid);
-      bool on_other = false;
-      facet_grid_->Query(q, [&](uint32_t g) {
-        if (on_other || !present[g]) return;
-        for (size_t k = i; k < j; ++k) {
-          if (wings[k].facet == g) return;
-        }
-        const FacetGeom& gg = facets_[g];
-        if (SideOf(gg.plane, u, tol_) == 0 && SideOf(gg.plane, v, tol_) == 0 &&
-            InFacetRegion(gg, mid)) {
-          on_other = true;
-        }
-      });
-      if (on_other) {
-        return cells_reason_ = absl::StrCat("facet ", wings[i].facet, "'s edge (", wings[i].key[0],
-                                            " ", wings[i].key[1], ") lies inside another facet"),
-               void();
-      }
-      i = j;
-    }
-    std::vector<uint32_t> uf(2 * nf);
+    const size_t np = pieces_.size();
+    std::vector<uint32_t> uf(2 * np);
     std::iota(uf.begin(), uf.end(), 0u);
     auto unite = [&](uint32_t a, uint32_t b) { uf[Find(uf, a)] = Find(uf, b); };
-    auto node = [](uint32_t f, int side) { return 2 * f + (side > 0 ? 0 : 1); };
+    auto node = [](uint32_t p, int side) { return 2 * p + (side > 0 ? 0 : 1); };
     for (size_t i = 0; i < wings.size();) {
       size_t j = i;
       while (j < wings.size() && wings[j].key == wings[i].key) ++j;
-      const Vec3 u = plc_->vertices[wings[i].key[0]], v = plc_->vertices[wings[i].key[1]];
+      const Vec3 u = PV(static_cast<uint32_t>(wings[i].key >> 32));
+      const Vec3 v = PV(static_cast<uint32_t>(wings[i].key));
       std::vector<const Wing*> w;
       for (size_t k = i; k < j; ++k) w.push_back(&wings[k]);
       i = j;
       if (w.size() == 1) {  // a free facet edge: both sides meet around it
-        unite(node(w[0]->facet, 1), node(w[0]->facet, -1));
+        unite(node(w[0]->piece, 1), node(w[0]->piece, -1));
         continue;
       }
       // Angular order around u->v from the first wing r0 (exact): class 0 = r0,
       // 1 = (0, π), 2 = π, 3 = (π, 2π); within 1 and 3, q after p iff
       // Orient3d(u, v, p, q) > 0.
-      const Vec3 r0 = w[0]->q;
+      const Vec3 r0 = PV(w[0]->q);
       const int axis0 = geom::DominantAxis(Cross(v - u, r0 - u));
       const int ref2d = geom::Orient2dProjected(u, v, r0, axis0);
       bool tie = false;
@@ -1104,13 +1237,13 @@ class Checker {
         return geom::Orient2dProjected(u, v, p, axis0) == ref2d ? 0 : 2;
       };
       std::vector<int> cl(w.size());
-      for (size_t k = 0; k < w.size(); ++k) cl[k] = cls(w[k]->q);
+      for (size_t k = 0; k < w.size(); ++k) cl[k] = cls(PV(w[k]->q));
       std::vector<size_t> order(w.size());
       std::iota(order.begin(), order.end(), size_t{0});
       std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
         if (cl[a] != cl[b]) return cl[a] < cl[b];
         if (a == b) return false;
-        const int s = geom::Orient3d(u, v, w[a]->q, w[b]->q);
+        const int s = geom::Orient3d(u, v, PV(w[a]->q), PV(w[b]->q));
         if (s == 0) tie = true;
         return s > 0 ? true : (s < 0 ? false : a < b);
       });
@@ -1121,23 +1254,21 @@ class Checker {
       // The wedge from wing a to the next wing b (increasing angle) lies on
       // the side Orient3d(u, v, q_a, .) > 0 of a and < 0 of b.
       auto facing = [&](const Wing& x, int toward) {
-        const FacetGeom& fg = facets_[x.facet];
-        const Vec3 y = fg.plane.a + fg.plane.n * cell_len_;
-        return toward * facet_sigma_[x.facet] * geom::Orient3d(u, v, x.q, y);
+        const uint32_t f = pieces_[x.piece].facet;
+        return toward * facet_sigma_[f] * geom::Orient3d(u, v, PV(x.q), AbovePlane(facets_[f]));
       };
       for (size_t k = 0; k < order.size(); ++k) {
         const Wing& a = *w[order[k]];
         const Wing& b = *w[order[(k + 1) % order.size()]];
         const int sa = facing(a, 1), sb = facing(b, -1);
         if (sa == 0 || sb == 0) return cells_reason_ = "a degenerate wing", void();
-        unite(node(a.facet, sa), node(b.facet, sb));
+        unite(node(a.piece, sa), node(b.piece, sb));
       }
     }
     // Shells.
-    node_shell_.assign(2 * nf, kNone);
-    for (size_t f = 0; f < nf; ++f) {
-      if (!present[f]) continue;
-      for (uint32_t nd : {node(f, 1), node(f, -1)}) {
+    node_shell_.assign(2 * np, kNone);
+    for (uint32_t p = 0; p < np; ++p) {
+      for (uint32_t nd : {node(p, 1), node(p, -1)}) {
         const uint32_t root = Find(uf, nd);
         if (node_shell_[root] == kNone) {
           node_shell_[root] = static_cast<uint32_t>(shell_nodes_.size());
@@ -1156,12 +1287,12 @@ class Checker {
       bool fin_only = true;
       double vol = 0;
       for (uint32_t nd : shell_nodes_[s]) {
-        const uint32_t f = nd / 2;
+        const Piece& pc = pieces_[nd / 2];
         const int side = nd % 2 == 0 ? 1 : -1;
         fin_only = fin_only && node_shell_[nd ^ 1u] == s;
-        const FacetGeom& fg = facets_[f];
-        const Vec3 out = -(side * facet_sigma_[f]) * fg.plane.n;
-        vol += fg.area * Dot(out, fg.plane.a - cell_origin_) / 3.0;
+        const FacetGeom& fg = facets_[pc.facet];
+        const Vec3 out = -(side * facet_sigma_[pc.facet]) * fg.plane.n;
+        vol += pc.area * Dot(out, fg.plane.a - cell_origin_) / 3.0;
       }
       shell_volume_[s] = fin_only ? 0 : vol;
       if (!fin_only && vol > 0) {
@@ -1171,15 +1302,15 @@ class Checker {
     }
     cell_volume_ = cell_outer_volume_;
     cell_volume_.push_back(0);  // the unbounded cell, id num_bounded_cells_
-    node_cell_.assign(2 * nf, -1);
+    node_cell_.assign(2 * np, -1);
     for (size_t s = 0; s < ns; ++s) {
       int32_t cell = shell_cell_of_positive_[s];
       if (cell < 0) {
-        // An inner shell: the cell on its side of one of its facets.
+        // An inner shell: the cell on its side of one of its pieces.
         const uint32_t nd = shell_nodes_[s][0];
         Vec3 x;
-        if (!FacetInteriorPoint(facets_[nd / 2], &x)) {
-          return cells_reason_ = "a facet without an interior point", void();
+        if (!PieceInteriorPoint(pieces_[nd / 2], &x)) {
+          return cells_reason_ = "a facet piece without an interior point", void();
         }
         cell = LocateCell(x, nd / 2);
         if (cell < 0) return cells_reason_ = "an inner shell touching another shell", void();
@@ -1448,17 +1579,32 @@ class Checker {
     }
     for (size_t f = 0; f < facets_.size(); ++f) {
       if (!facets_[f].valid) continue;
-      // A facet no tet touches lies outside the meshed domain (e.g. between a
-      // volume hole and the exterior): TetGen and we drop it.
-      const bool outside =
-          cells_known_ ? node_cell_[2 * f] >= 0 && cell_hole_[node_cell_[2 * f]] &&
-                             node_cell_[2 * f + 1] >= 0 && cell_hole_[node_cell_[2 * f + 1]]
-                       : covered[f] == 0 && !facet_crossed_[f] && !AnyTetFaceOn(f);
-      if (outside) {
+      // Outside the domain: with cells, every piece with unmeshed cells on
+      // both sides (e.g. between a volume hole and the exterior: TetGen and
+      // we drop it); without, a facet no tet touches.
+      double want = facets_[f].area;
+      if (cells_known_ && !facet_pieces_[f].empty()) {
+        double inside_area = 0;
+        size_t out = 0;
+        for (uint32_t p : facet_pieces_[f]) {
+          if (cell_hole_[node_cell_[2 * p]] && cell_hole_[node_cell_[2 * p + 1]]) {
+            ++out;
+          } else {
+            inside_area += pieces_[p].area;
+          }
+        }
+        if (out == facet_pieces_[f].size()) {
+          ++rep_->num_facets_outside;
+          continue;
+        }
+        if (out > 0) {
+          ++rep_->num_facets_partly_outside;
+          want = inside_area;
+        }
+      } else if (!cells_known_ && covered[f] == 0 && !facet_crossed_[f] && !AnyTetFaceOn(f)) {
         ++rep_->num_facets_outside;
         continue;
       }
-      const double want = facets_[f].area;
       if (std::fabs(covered[f] - want) > opt_.area_rel_tol * want) {
         Add(rep_, opt_, ViolationKind::kFacetNotCovered, {static_cast<int64_t>(f)},
             absl::StrFormat("facet %d: mesh triangles on it cover area %.17g, facet area %.17g", f,
@@ -1703,7 +1849,6 @@ class Checker {
 
   void CheckCrossings() {
     facet_crossed_.assign(facets_.size(), 0);
-    region_.resize(facets_.size());
     if (mesh_box_.Empty() || mesh_.tets.empty()) return;
     const BoxGrid& tet_grid = TetGrid();
     std::vector<uint32_t> stamp(mesh_.tets.size(), kNone);
@@ -1775,6 +1920,8 @@ class Checker {
   Vec3 cell_origin_;
   double cell_len_ = 1;
   std::vector<int> facet_sigma_;
+  std::vector<Piece> pieces_;
+  std::vector<std::vector<uint32_t>> facet_pieces_;
   std::vector<uint32_t> node_shell_;
   std::vector<std::vector<uint32_t>> shell_nodes_;
   std::vector<double> shell_volume_;

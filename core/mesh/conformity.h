@@ -84,7 +84,12 @@ struct ConformityReport {
   std::string cells_unknown_reason;   // when !cells_known
   size_t num_segments_checked = 0;
   size_t num_facets_checked = 0;   // valid (planar, non-degenerate) facets
-  size_t num_facets_outside = 0;   // of those, touched by no tet: outside the domain
+  // Of those, facets outside the domain: the cells on both sides of every
+  // piece are unmeshed (cells known), else touched by no tet (docs/conformity.md).
+  size_t num_facets_outside = 0;
+  // Facets some of whose pieces are outside the domain (cells known only);
+  // only the other pieces must be covered.
+  size_t num_facets_partly_outside = 0;
 
   bool ok() const;
   size_t Count(ViolationKind kind) const { return counts[static_cast<int>(kind)]; }

@@ -45,12 +45,11 @@ TEST(Conformity, AcceptsInternalFacetAndFarOffset) {
   const plc::Plc split = BoxPlc(kLo, kHi, /*split=*/true);
   const ConformityReport r = CheckConformity(split, KuhnBoxMesh(split, 2));
   EXPECT_TRUE(r.ok()) << r.Summary();
-  // BoxPlc's internal facet ends inside the box's side facets (their sides
-  // would split into pieces): cells and volume unknown (docs/conformity.md).
-  EXPECT_FALSE(r.cells_known);
-  EXPECT_FALSE(r.enclosed_volume_known);
-  EXPECT_NE(r.cells_unknown_reason.find("lies inside another facet"), std::string::npos)
-      << r.cells_unknown_reason;
+  // BoxPlc's internal facet ends inside the box's side facets, whose inner
+  // sides split into two pieces each (docs/conformity.md "Pieces").
+  EXPECT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_EQ(r.num_cells, 2u);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
   const plc::Plc far = BoxPlc(Vec3(1e6, 1e6, 1e6), Vec3(1e6 + 1000, 1e6 + 1000, 1e6 + 1000));
   const ConformityReport r2 = CheckConformity(far, KuhnBoxMesh(far, 4));
   EXPECT_TRUE(r2.ok()) << r2.Summary();
@@ -685,6 +684,126 @@ TEST(Conformity, FacetOutsideTheDomainIsDecidedByItsCells) {
   // not classified by cells (docs/conformity.md).
   EXPECT_EQ(r.Count(ViolationKind::kBrokenSegment), 4u) << r.Summary();
   EXPECT_EQ(r.Count(ConformityCategory::kConformity), 4u) << r.Summary();
+}
+
+// The unit box (six whole quads) split by an internal facet z = 1/2 and, in
+// the upper half only, by an internal facet x = 1/2 whose bottom edge lies
+// inside the z = 1/2 facet and whose other edges lie inside the y = 0, y = 1
+// and z = 1 facets: every facet but x = 1/2 has a side split into pieces.
+// Cells: bottom (seed 0), top left (seed 1), top right (seed 2).
+plc::Plc TBoxPlc() {
+  plc::Plc p = BoxPlc(kLo, kHi);
+  const uint32_t b = static_cast<uint32_t>(p.vertices.size());
+  for (const Vec3& v : {Vec3(0, 0, 0.5), Vec3(1, 0, 0.5), Vec3(1, 1, 0.5), Vec3(0, 1, 0.5),
+                        Vec3(0.5, 0, 0.5), Vec3(0.5, 1, 0.5), Vec3(0.5, 1, 1), Vec3(0.5, 0, 1)}) {
+    p.vertices.push_back(v);
+  }
+  auto quad = [&](std::vector<uint32_t> v, int32_t marker) {
+    plc::Facet f;
+    f.polygons.push_back({std::move(v)});
+    f.marker = marker;
+    p.facets.push_back(std::move(f));
+  };
+  quad({b, b + 1, b + 2, b + 3}, 7);
+  quad({b + 4, b + 5, b + 6, b + 7}, 8);
+  p.regions = {{Vec3(0.5, 0.5, 0.25), 1, 0}, {Vec3(0.25, 0.5, 0.75), 2, 0},
+               {Vec3(0.75, 0.5, 0.75), 3, 0}};
+  return p;
+}
+
+TEST(Conformity, FacetSidesSplitIntoPieces) {
+  const plc::Plc p = TBoxPlc();
+  TetMesh m = KuhnBoxMesh(p, 4);
+  testing::AssignAxisAlignedTriangles(p, &m);
+  const ConformityReport r = CheckConformity(p, m);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  ASSERT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_EQ(r.num_cells, 3u);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
+  EXPECT_EQ(r.num_facets_outside, 0u);
+  {
+    // The same with the x = 1/2 facet's bottom edge and the z = 1/2 facet's
+    // edge on y = 0 declared as in-facet segments (2-vertex polygons) of the
+    // facets they lie in, as the PLC validator wants them.
+    plc::Plc declared = p;
+    declared.facets[6].polygons.push_back({{12, 13}});  // z = 1/2: (½,0,½)-(½,1,½)
+    declared.facets[2].polygons.push_back({{8, 9}});    // y = 0: (0,0,½)-(1,0,½)
+    const ConformityReport rd = CheckConformity(declared, m);
+    EXPECT_TRUE(rd.ok()) << rd.Summary();
+    EXPECT_TRUE(rd.cells_known) << rd.cells_unknown_reason;
+    EXPECT_EQ(rd.num_cells, 3u);
+  }
+
+  // Top right region deleted and top left meshed twice (a shifted copy of its
+  // tets over a copy of the vertices): the total volume is unchanged, so
+  // only the cell-by-cell check sees it.
+  auto centroid = [&](const std::array<uint32_t, 4>& t) {
+    return (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]] + m.positions[t[3]]) / 4.0;
+  };
+  TetMesh bad = m;
+  const uint32_t nv = static_cast<uint32_t>(m.positions.size());
+  bad.positions.insert(bad.positions.end(), m.positions.begin(), m.positions.end());
+  bad.tets.clear();
+  for (const auto& t : m.tets) {
+    const Vec3 c = centroid(t);
+    if (c.z > 0.5 && c.x > 0.5) continue;
+    bad.tets.push_back(t);
+    if (c.z > 0.5 && c.x < 0.5) bad.tets.push_back({t[0] + nv, t[1] + nv, t[2] + nv, t[3] + nv});
+  }
+  bad.tet_region.assign(bad.tets.size(), 0);
+  EXPECT_NEAR(TotalVolume(bad), TotalVolume(m), 1e-12);
+  ConformityOptions opt;
+  opt.input_vertices_first = false;
+  const ConformityReport rb = CheckConformity(p, bad, opt);
+  ASSERT_TRUE(rb.cells_known) << rb.cells_unknown_reason;
+  EXPECT_EQ(rb.Count(ViolationKind::kVolumeMismatch), 2u) << rb.Summary();
+  const std::string sum = rb.Summary();
+  EXPECT_NE(sum.find("region seed(s) 1: tets in it have volume"), std::string::npos) << sum;
+  EXPECT_NE(sum.find("more than once"), std::string::npos) << sum;
+  EXPECT_NE(sum.find("region seed(s) 2: tets in it have volume"), std::string::npos) << sum;
+  EXPECT_NE(sum.find("not filled"), std::string::npos) << sum;
+}
+
+TEST(Conformity, FacetPartlyOutsideTheDomain) {
+  // The unit box standing on the square [-1, 2]^2 x {0} (instead of its own
+  // bottom facet): the box's side facets end inside the square, which splits
+  // into the box's bottom (bounding the box's cell) and a ring with the
+  // unbounded cell on both sides, which is outside the domain.
+  plc::Plc p = BoxPlc(kLo, kHi);
+  p.facets.erase(p.facets.begin() + 4);  // z = 0
+  const uint32_t b = static_cast<uint32_t>(p.vertices.size());
+  for (const Vec3& v : {Vec3(-1, -1, 0), Vec3(2, -1, 0), Vec3(2, 2, 0), Vec3(-1, 2, 0)}) {
+    p.vertices.push_back(v);
+  }
+  plc::Facet f;
+  f.polygons.push_back({{b, b + 1, b + 2, b + 3}});
+  f.marker = 5;
+  p.facets.push_back(f);
+  TetMesh m = KuhnBoxMesh(p, 2);
+  testing::AssignAxisAlignedTriangles(p, &m);
+  const ConformityReport r = CheckConformity(p, m);
+  ASSERT_TRUE(r.cells_known) << r.cells_unknown_reason;
+  EXPECT_EQ(r.num_cells, 1u);
+  EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
+  EXPECT_EQ(r.num_facets_outside, 0u);
+  EXPECT_EQ(r.num_facets_partly_outside, 1u);
+  EXPECT_EQ(r.Count(ConformityCategory::kCoverage), 0u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kFacetNotCovered), 0u) << r.Summary();
+  // The square's own edges lie outside the domain and are still required
+  // (segments are not classified by cells), as in FacetOutsideTheDomain...
+  EXPECT_EQ(r.Count(ViolationKind::kBrokenSegment), 4u) << r.Summary();
+  EXPECT_EQ(r.Count(ConformityCategory::kConformity), 4u) << r.Summary();
+  // Without the box's bottom triangles the inside piece is not covered.
+  TetMesh open = m;
+  open.triangles.clear();
+  open.triangle_marker.clear();
+  for (size_t i = 0; i < m.triangles.size(); ++i) {
+    if (m.triangle_marker[i] == 5) continue;
+    open.triangles.push_back(m.triangles[i]);
+    open.triangle_marker.push_back(m.triangle_marker[i]);
+  }
+  const ConformityReport ro = CheckConformity(p, open);
+  EXPECT_EQ(ro.Count(ViolationKind::kFacetNotCovered), 1u) << ro.Summary();
 }
 
 TEST(Conformity, ScalesToHundredsOfThousandsOfTets) {

@@ -3,6 +3,7 @@
 // meshes, broken on purpose, must fail in the right category.
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -20,14 +21,13 @@ namespace {
 namespace fs = std::filesystem;
 using testing::HaveTool;
 
-// Runs `tetgen -<switches>` on a copy of the corpus file in a fresh folder and
+// Runs `tetgen -<switches>` on a copy of the file `src` in a fresh folder and
 // returns the path of the .1.node it wrote ("" after a failed expectation).
-std::string RunTetgen(const std::string& corpus_file, const std::string& switches) {
+std::string RunTetgenOn(const fs::path& src, const std::string& switches) {
   if (!HaveTool("tetgen")) {
     ADD_FAILURE() << "tetgen not installed (scripts/setup.sh installs it)";
     return "";
   }
-  const fs::path src = svrc::testing::CorpusPath(corpus_file);
   const fs::path dir = svrc::testing::MakeTempDir("tetgen");
   const fs::path copy = dir / src.filename();
   fs::copy_file(src, copy);
@@ -41,6 +41,10 @@ std::string RunTetgen(const std::string& corpus_file, const std::string& switche
   node.replace_extension(".1.node");
   EXPECT_TRUE(fs::exists(node)) << node;
   return node.string();
+}
+
+std::string RunTetgen(const std::string& corpus_file, const std::string& switches) {
+  return RunTetgenOn(svrc::testing::CorpusPath(corpus_file), switches);
 }
 
 struct Case {
@@ -240,6 +244,119 @@ TEST_F(TetgenRegions, DuplicatedRegionIsRejected) {
   EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 1u) << r.Summary();
   EXPECT_NE(r.Summary().find("region seed(s) 1"), std::string::npos) << r.Summary();
   EXPECT_NE(r.Summary().find("more than once"), std::string::npos) << r.Summary();
+}
+
+// The unit box split by an internal facet z = 1/2 and, in the upper half
+// only, by an internal facet x = 1/2 whose bottom edge is an in-facet segment
+// of the z = 1/2 facet and whose other edges are in-facet segments of the
+// y = 0, y = 1 and z = 1 facets (polygon edges split at the T-junction
+// vertices, which tetgen 1.5.0 needs). Every facet but x = 1/2 has a side
+// split into pieces (docs/conformity.md "Pieces"); three cells.
+constexpr char kTBoxPoly[] = R"(# T-box
+16 3 0 0
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 1 1 0
+5 0 0 1
+6 1 0 1
+7 0 1 1
+8 1 1 1
+9 0 0 0.5
+10 1 0 0.5
+11 1 1 0.5
+12 0 1 0.5
+13 0.5 0 0.5
+14 0.5 1 0.5
+15 0.5 1 1
+16 0.5 0 1
+8 1
+2 0 1
+6 1 3 12 7 5 9
+2 9 12
+2 0 2
+6 2 4 11 8 6 10
+2 10 11
+4 0 3
+7 1 2 10 6 16 5 9
+2 9 13
+2 13 10
+2 13 16
+4 0 4
+7 3 4 11 8 15 7 12
+2 12 14
+2 14 11
+2 14 15
+1 0 5
+4 1 2 4 3
+2 0 6
+6 5 16 6 8 15 7
+2 15 16
+2 0 7
+6 9 13 10 11 14 12
+2 13 14
+1 0 8
+4 13 14 15 16
+0
+3
+1 0.5 0.5 0.25 1 -1
+2 0.25 0.5 0.75 2 -1
+3 0.75 0.5 0.75 3 -1
+)";
+
+TEST(TetgenPieces, CellsOfFacetsSplitIntoPieces) {
+  const fs::path dir = svrc::testing::MakeTempDir("tbox");
+  const fs::path poly = dir / "tbox.poly";
+  {
+    std::ofstream out(poly);
+    out << kTBoxPoly;
+  }
+  auto plc = plc::ReadPlcFile(poly.string());
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  ConformityOptions opt;
+  opt.input_vertices_first = false;
+  for (const char* sw : {"pAQ", "pq1.5a0.01AQ"}) {
+    const std::string node = RunTetgenOn(poly, sw);
+    ASSERT_FALSE(node.empty());
+    auto mesh = ReadTetgenMesh(node);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    const ConformityReport r = CheckConformity(*plc, *mesh, opt);
+    EXPECT_TRUE(r.ok()) << sw << "\n" << r.Summary();
+    ASSERT_TRUE(r.cells_known) << sw << ": " << r.cells_unknown_reason;
+    EXPECT_EQ(r.num_cells, 3u);
+    EXPECT_NEAR(r.enclosed_volume, 1.0, 1e-12);
+    EXPECT_NEAR(r.mesh_volume, 1.0, 1e-12);
+    EXPECT_EQ(r.num_facets_outside, 0u);
+
+    // The top right region deleted and the top left one meshed twice: the
+    // same total volume, caught cell by cell.
+    const TetMesh& m = *mesh;
+    TetMesh bad = m;
+    const uint32_t nv = static_cast<uint32_t>(m.positions.size());
+    bad.positions.insert(bad.positions.end(), m.positions.begin(), m.positions.end());
+    bad.tets.clear();
+    bad.tet_region.clear();
+    for (size_t t = 0; t < m.tets.size(); ++t) {
+      const auto& q = m.tets[t];
+      const Vec3 c = (m.positions[q[0]] + m.positions[q[1]] + m.positions[q[2]] +
+                      m.positions[q[3]]) / 4.0;
+      if (c.z > 0.5 && c.x > 0.5) continue;
+      bad.tets.push_back(q);
+      bad.tet_region.push_back(m.tet_region[t]);
+      if (c.z > 0.5 && c.x < 0.5) {
+        bad.tets.push_back({q[0] + nv, q[1] + nv, q[2] + nv, q[3] + nv});
+        bad.tet_region.push_back(m.tet_region[t]);
+      }
+    }
+    const ConformityReport rb = CheckConformity(*plc, bad, opt);
+    EXPECT_NEAR(rb.mesh_volume, 1.0, 1e-12);
+    EXPECT_EQ(rb.Count(ViolationKind::kVolumeMismatch), 2u) << sw << "\n" << rb.Summary();
+    const std::string sum = rb.Summary();
+    EXPECT_NE(sum.find("region seed(s) 1: tets in it have volume"), std::string::npos) << sum;
+    EXPECT_NE(sum.find("region seed(s) 2: tets in it have volume"), std::string::npos) << sum;
+    EXPECT_NE(sum.find("more than once"), std::string::npos) << sum;
+    EXPECT_NE(sum.find("not filled"), std::string::npos) << sum;
+  }
 }
 
 }  // namespace
