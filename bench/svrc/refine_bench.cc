@@ -7,19 +7,73 @@
 // Prints vertices, tets, time, and the per-run counters of RefineStats.
 //   comb  n : n parallel unit segments 10^-3 apart (stage (b));
 //   nearseg k: a unit segment and a point 10^-k from its midpoint.
-// Usage: svrc_refine_bench skew 1000 | pair 12 | random 10000 | comb 4 | nearseg 6 [tau]
+// Usage: svrc_refine_bench [--hash] skew 1000 | pair 12 | random 10000 | comb 4 | nearseg 6 [tau]
+//   --hash: also print an FNV-1a 64 hash of the output (position bits, tets in
+//           output order, segment chains) to check that a change of the
+//           implementation left the output byte-identical.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/svrc/refiner.h"
 
+namespace {
+
+// FNV-1a, 64 bit, over raw bytes (doubles by their bit patterns).
+struct Fnv64 {
+  uint64_t h = 0xcbf29ce484222325ull;
+  void Bytes(const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) {
+      h ^= b[i];
+      h *= 0x100000001b3ull;
+    }
+  }
+  template <typename T>
+  void Value(const T& v) {
+    Bytes(&v, sizeof v);
+  }
+};
+
+uint64_t HashOutput(const svrc::refine::PointSetRefinement& r) {
+  Fnv64 f;
+  f.Value(uint64_t{r.positions.size()});
+  for (const auto& p : r.positions) {
+    f.Value(p.x);
+    f.Value(p.y);
+    f.Value(p.z);
+  }
+  f.Value(uint64_t{r.tets.size()});
+  for (const auto& t : r.tets) f.Bytes(t.data(), sizeof(uint32_t) * 4);
+  f.Value(uint64_t{r.segment_chains.size()});
+  for (const auto& c : r.segment_chains) {
+    f.Value(uint64_t{c.size()});
+    f.Bytes(c.data(), sizeof(uint32_t) * c.size());
+  }
+  return f.h;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  bool hash = false;
+  if (argc > 1 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
+    std::printf("usage: %s [--hash] skew|pair|random|comb|nearseg N [tau]\n", argv[0]);
+    return 0;
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--hash") == 0) {
+    hash = true;
+    --argc;
+    ++argv;
+  }
   if (argc < 3) {
-    std::fprintf(stderr, "usage: %s skew|pair|random N [tau]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s [--hash] skew|pair|random|comb|nearseg N [tau]\n", argv[0]);
     return 2;
   }
   const std::string kind = argv[1];
@@ -51,7 +105,13 @@ int main(int argc, char** argv) {
     std::uniform_real_distribution<double> u(0, 1);
     for (int i = 0; i < n; ++i) pts.push_back({u(rng), u(rng), u(rng)});
   }
+  // Process CPU time of the whole call (Initialize + Run + Output): on the
+  // shared machine wall time (RefineStats::seconds) is inflated by the load.
+  timespec cpu0, cpu1;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu0);
   auto r = svrc::refine::RefinePointsAndSegments(pts, segs, options);
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu1);
+  const double cpu = double(cpu1.tv_sec - cpu0.tv_sec) + 1e-9 * double(cpu1.tv_nsec - cpu0.tv_nsec);
   if (!r.ok()) {
     std::fprintf(stderr, "%s\n", r.status().ToString().c_str());
     return 1;
@@ -73,5 +133,10 @@ int main(int argc, char** argv) {
       (unsigned long long)s.events_stale[0], (unsigned long long)s.events_popped[2],
       (unsigned long long)s.events_stale[2], (unsigned long long)s.predicate_exact,
       (unsigned long long)s.predicate_calls, (unsigned long long)s.predicate_sos);
+  std::printf("cpu_seconds=%.3f cpu_us/vertex=%.2f\n", cpu, 1e6 * cpu / double(s.vertices));
+  if (hash) {
+    std::printf("hash=%016llx positions=%zu tets=%zu\n", (unsigned long long)HashOutput(*r),
+                r->positions.size(), r->tets.size());
+  }
   return 0;
 }

@@ -358,15 +358,22 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
         h = (h + 1) & mask;
       }
     }
-    // Vertex → tet for p and the boundary face's vertices.
+    // Vertex → tet for p and the boundary face's vertices; their stars
+    // changed, so do their cached neighbour lists.
     for (int i = 0; i < 4; ++i) {
-      if (tv[i] != kInf) vertex_tet_[tv[i]] = t;
+      if (tv[i] != kInf) {
+        vertex_tet_[tv[i]] = t;
+        if (cache_neighbors_) InvalidateAdj(tv[i]);
+      }
     }
   }
 
   cavity_vertices_.clear();
   if (report_cavity_vertices_) {
-    ++vertex_stamp_;
+    if (++vertex_stamp_ == 0) {
+      std::fill(vertex_mark_.begin(), vertex_mark_.end(), 0);
+      vertex_stamp_ = 1;
+    }
     if (vertex_mark_.size() < points_.size()) {
       vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
     }
@@ -543,80 +550,167 @@ std::vector<TetId> Delaunay3::FiniteTets() const {
   return out;
 }
 
-void Delaunay3::StarRaw(uint32_t v, std::vector<uint32_t>* out) const {
-  out->clear();
+// ---------------------------------------------------------------------------
+// The star walk.
+
+// Breadth-first over the tets around v: from each tet, cross its three faces
+// that contain v. The order (queue order, faces 0..3) is what Star has always
+// returned; the neighbours come out in order of first appearance in it.
+template <bool kNeighbors>
+uint32_t Delaunay3::WalkStar(uint32_t v, uint32_t* num_neighbors) const {
+  uint32_t n = 0, m = 0;
   const uint32_t t0 = vertex_tet_[v];
-  if (t0 == kFreeSlot) return;
-  const uint32_t stamp = FreshStamps(1);
-  out->push_back(t0);
-  tet_mark_[t0] = stamp;
-  for (size_t k = 0; k < out->size(); ++k) {
-    const uint32_t t = (*out)[k];
+  if (t0 == kFreeSlot) {
+    if (num_neighbors != nullptr) *num_neighbors = 0;
+    return 0;
+  }
+  if (star_buf_.size() < 64) star_buf_.resize(64);
+  if (kNeighbors && nbr_buf_.size() < 64) {
+    nbr_buf_.resize(64);
+    nbr_tet_buf_.resize(64);
+  }
+  const uint32_t tstamp = FreshStamps(1);
+  uint32_t* tmark = tet_mark_.data();
+  uint32_t vstamp = 0;
+  if (kNeighbors) {
+    if (++vertex_stamp_ == 0) {
+      std::fill(vertex_mark_.begin(), vertex_mark_.end(), 0);
+      vertex_stamp_ = 1;
+    }
+    if (vertex_mark_.size() < points_.size()) {
+      vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
+    }
+    vstamp = vertex_stamp_;
+  }
+  uint32_t* vmark = vertex_mark_.data();
+  const uint32_t* tets = tets_.data();
+  TetId* star = star_buf_.data();
+  star[n++] = TetId(t0);
+  tmark[t0] = tstamp;
+  for (uint32_t k = 0; k < n; ++k) {
+    const uint32_t t = star[k].value();
+    const uint32_t* tv = &tets[8 * t];
+    // Room for the (at most 3) tets and (at most 3) vertices this tet adds.
+    if (n + 3 > star_buf_.size()) {
+      star_buf_.resize(2 * star_buf_.size());
+      star = star_buf_.data();
+    }
+    if (kNeighbors && m + 3 > nbr_buf_.size()) {
+      nbr_buf_.resize(2 * nbr_buf_.size());
+      nbr_tet_buf_.resize(nbr_buf_.size());
+    }
     for (int f = 0; f < 4; ++f) {
-      if (tets_[8 * t + f] == v) continue;  // the face opposite v does not contain v
-      const uint32_t u = tets_[8 * t + 4 + f] >> 2;
-      if (tet_mark_[u] != stamp) {
-        tet_mark_[u] = stamp;
-        out->push_back(u);
+      const uint32_t w = tv[f];
+      if (w == v) continue;  // the face opposite v does not contain v
+      if (kNeighbors && w != kInf && vmark[w] != vstamp) {
+        vmark[w] = vstamp;
+        nbr_buf_[m] = VertexId(w);
+        nbr_tet_buf_[m] = TetId(t);
+        ++m;
+      }
+      const uint32_t u = tv[4 + f] >> 2;
+      if (tmark[u] != tstamp) {
+        tmark[u] = tstamp;
+        __builtin_prefetch(&tets[8 * u]);
+        star[n++] = TetId(u);
       }
     }
   }
+  if (num_neighbors != nullptr) *num_neighbors = m;
+  return n;
 }
 
 void Delaunay3::Star(VertexId v, std::vector<TetId>* out) const {
-  std::vector<uint32_t> raw;
-  StarRaw(v.value(), &raw);
-  out->clear();
-  out->reserve(raw.size());
-  for (uint32_t t : raw) out->push_back(TetId(t));
+  const uint32_t n = WalkStar<false>(v.value(), nullptr);
+  out->assign(star_buf_.begin(), star_buf_.begin() + n);
 }
 
 void Delaunay3::Neighbors(VertexId v, std::vector<VertexId>* out) const {
-  std::vector<uint32_t> star;
-  StarRaw(v.value(), &star);
-  out->clear();
-  ++vertex_stamp_;
-  if (vertex_mark_.size() < points_.size()) vertex_mark_.resize(points_.size() + 16, 0);
-  for (uint32_t t : star) {
-    for (int i = 0; i < 4; ++i) {
-      const uint32_t w = tets_[8 * t + i];
-      if (w == kInf || w == v.value() || vertex_mark_[w] == vertex_stamp_) continue;
-      vertex_mark_[w] = vertex_stamp_;
-      out->push_back(VertexId(w));
+  const std::span<const VertexId> n = NeighborsView(v);
+  out->assign(n.begin(), n.end());
+}
+
+std::span<const TetId> Delaunay3::StarView(VertexId v) const {
+  const uint32_t n = WalkStar<false>(v.value(), nullptr);
+  return {star_buf_.data(), n};
+}
+
+void Delaunay3::set_cache_neighbors(bool on) {
+  cache_neighbors_ = on;
+  adj_.clear();
+  adj_.shrink_to_fit();
+  adj_pool_.clear();
+  adj_pool_.shrink_to_fit();
+  adj_live_ = 0;
+}
+
+// Appends nbr_buf_[0, m) to the pool as v's list. The pool is compacted (in
+// vertex order) when most of it is stale.
+void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
+  if (adj_.size() <= v) adj_.resize(points_.size() + points_.size() / 2 + 16);
+  if (adj_pool_.size() + m > adj_pool_.capacity() && adj_pool_.size() > 4 * adj_live_ + 4096) {
+    std::vector<VertexId> pool;
+    pool.reserve(2 * adj_live_ + 4096);
+    for (AdjEntry& e : adj_) {
+      if (e.size == kNoAdj) continue;
+      const uint32_t off = static_cast<uint32_t>(pool.size());
+      pool.insert(pool.end(), adj_pool_.begin() + e.offset, adj_pool_.begin() + e.offset + e.size);
+      e.offset = off;
     }
+    adj_pool_.swap(pool);
   }
+  AdjEntry& e = adj_[v];
+  e.offset = static_cast<uint32_t>(adj_pool_.size());
+  e.size = m;
+  adj_pool_.insert(adj_pool_.end(), nbr_buf_.begin(), nbr_buf_.begin() + m);
+  adj_live_ += m;
+}
+
+std::span<const VertexId> Delaunay3::NeighborsView(VertexId v) const {
+  const uint32_t i = v.value();
+  if (cache_neighbors_ && i < adj_.size() && adj_[i].size != kNoAdj) {
+    return {adj_pool_.data() + adj_[i].offset, adj_[i].size};
+  }
+  uint32_t m = 0;
+  WalkStar<true>(i, &m);
+  if (cache_neighbors_ && vertex_tet_[i] != kFreeSlot) StoreAdj(i, m);
+  return {nbr_buf_.data(), m};
+}
+
+Delaunay3::StarAndNeighbors Delaunay3::StarAndNeighborsView(VertexId v) const {
+  const uint32_t i = v.value();
+  uint32_t m = 0;
+  const uint32_t n = WalkStar<true>(i, &m);
+  if (cache_neighbors_ && vertex_tet_[i] != kFreeSlot && (i >= adj_.size() || adj_[i].size == kNoAdj)) {
+    StoreAdj(i, m);
+  }
+  return {{star_buf_.data(), n}, {nbr_buf_.data(), m}, {nbr_tet_buf_.data(), m}};
 }
 
 bool Delaunay3::IsHullVertex(VertexId v) const {
-  std::vector<uint32_t> star;
-  StarRaw(v.value(), &star);
-  for (uint32_t t : star) {
-    if (tets_[8 * t + 3] == kInf) return true;
+  for (TetId t : StarView(v)) {
+    if (tets_[8 * t.value() + 3] == kInf) return true;
   }
   return false;
 }
 
 void Delaunay3::VoronoiCorners(VertexId v, std::vector<Vec3>* out) const {
-  std::vector<uint32_t> star;
-  StarRaw(v.value(), &star);
   out->clear();
-  for (uint32_t t : star) {
-    if (tets_[8 * t + 3] != kInf) out->push_back(Circumcenter(TetId(t)));
+  for (TetId t : StarView(v)) {
+    if (tets_[8 * t.value() + 3] != kInf) out->push_back(Circumcenter(t));
   }
 }
 
 double Delaunay3::OutRadius(VertexId v, Vec3* farthest_corner) const {
-  std::vector<uint32_t> star;
-  StarRaw(v.value(), &star);
   const Vec3& pv = points_[v.value()];
   double best = -1;
   Vec3 corner;
-  for (uint32_t t : star) {
-    if (tets_[8 * t + 3] == kInf) {
+  for (TetId t : StarView(v)) {
+    if (tets_[8 * t.value() + 3] == kInf) {
       if (farthest_corner) *farthest_corner = Vec3(HUGE_VAL, HUGE_VAL, HUGE_VAL);
       return std::numeric_limits<double>::infinity();
     }
-    const Vec3 c = Circumcenter(TetId(t));
+    const Vec3 c = Circumcenter(t);
     const double d = geom::Dist(c, pv);
     if (d > best) {
       best = d;
@@ -628,11 +722,9 @@ double Delaunay3::OutRadius(VertexId v, Vec3* farthest_corner) const {
 }
 
 double Delaunay3::InRadius(VertexId v) const {
-  std::vector<VertexId> nbrs;
-  Neighbors(v, &nbrs);
   const Vec3& pv = points_[v.value()];
   double best = std::numeric_limits<double>::infinity();
-  for (VertexId w : nbrs) best = std::min(best, geom::Dist2(points_[w.value()], pv));
+  for (VertexId w : NeighborsView(v)) best = std::min(best, geom::Dist2(points_[w.value()], pv));
   return 0.5 * std::sqrt(best);
 }
 
@@ -656,11 +748,9 @@ VertexId Delaunay3::NearestVertex(const Vec3& p, TetId hint) const {
   // Greedy descent: in a Delaunay graph, a vertex that is not nearest to p
   // has a neighbour strictly nearer (the Delaunay graph contains the nearest
   // neighbour's Voronoi adjacency along the segment to p).
-  std::vector<VertexId> nbrs;
   for (;;) {
-    Neighbors(VertexId(best), &nbrs);
     bool improved = false;
-    for (VertexId w : nbrs) improved |= consider(w.value());
+    for (VertexId w : NeighborsView(VertexId(best))) improved |= consider(w.value());
     if (!improved) return VertexId(best);
   }
 }

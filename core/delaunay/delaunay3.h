@@ -95,6 +95,16 @@ class Delaunay3 {
   // batch build that does not need them turns this off to save time.
   void set_report_cavity_vertices(bool on) { report_cavity_vertices_ = on; }
 
+  // Whether neighbour lists are cached per vertex (default false). With the
+  // cache, Neighbors / NeighborsView (and NearestVertex, InRadius) answer from
+  // a compact per-vertex list instead of walking ~25 scattered tets, which
+  // pays off when the same cells are asked about repeatedly between
+  // insertions (SVRC's cell searches on M_Ω). An insertion invalidates
+  // exactly the vertices of the new tets: a vertex in no new tet keeps its
+  // star, its VertexTet and hence its answer (same contents, same order).
+  // Costs ~8 bytes per vertex plus the lists.
+  void set_cache_neighbors(bool on);
+
   // Inserts `p` with SoS priority `global_id`. `hint` is any live tet near p
   // (kNoneTet: the last created tet): if it conflicts with p the cavity grows
   // from it directly — SVRC's ForceInsert passes a known conflicting tet and
@@ -150,8 +160,25 @@ class Delaunay3 {
 
   // Tets incident to v, ghosts included, in a deterministic (BFS) order.
   void Star(VertexId v, std::vector<TetId>* out) const;
-  // Finite vertices sharing an edge with v, in a deterministic order.
+  // Finite vertices sharing an edge with v, in a deterministic order: by first
+  // appearance in Star order, then by position in the tet.
   void Neighbors(VertexId v, std::vector<VertexId>* out) const;
+
+  // Allocation-free variants (after warm-up): the same contents in the same
+  // order as Star / Neighbors, returned as views of scratch owned by the
+  // triangulation. A view stays valid until the next vertex query (any
+  // function of this section, including the *View ones) or mutation.
+  std::span<const TetId> StarView(VertexId v) const;
+  std::span<const VertexId> NeighborsView(VertexId v) const;
+  // One walk for both: the star (as StarView), the neighbours (as
+  // NeighborsView) and, per neighbour, the first tet in star order that
+  // contains it (a tet of the ring around the edge v–neighbour).
+  struct StarAndNeighbors {
+    std::span<const TetId> star;
+    std::span<const VertexId> neighbors;
+    std::span<const TetId> neighbor_tet;
+  };
+  StarAndNeighbors StarAndNeighborsView(VertexId v) const;
   // True iff v is on the convex hull (incident to a ghost tet).
   bool IsHullVertex(VertexId v) const;
   // Circumcentres of the finite tets incident to v (the corners of v's Voronoi
@@ -210,7 +237,27 @@ class Delaunay3 {
   void BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d);
   InsertResult InsertVertex(uint32_t v, uint32_t start_conflict, uint32_t sos_used);
   void LinkAroundApex(uint32_t apex);
-  void StarRaw(uint32_t v, std::vector<uint32_t>* out) const;
+  // The star walk behind every vertex query: fills star_buf_ (BFS order from
+  // VertexTet(v)) and, with kNeighbors, nbr_buf_ / nbr_tet_buf_; returns the
+  // star size. Visited sets are stamps in tet_mark_ / vertex_mark_ (measured
+  // faster than small hash sets: the stamp lines are hot after the first
+  // query of a neighbourhood).
+  template <bool kNeighbors>
+  uint32_t WalkStar(uint32_t v, uint32_t* num_neighbors) const;
+
+  // Neighbour cache (set_cache_neighbors): per vertex, its list in adj_pool_.
+  static constexpr uint32_t kNoAdj = 0xFFFFFFFFu;
+  struct AdjEntry {
+    uint32_t offset = 0;
+    uint32_t size = kNoAdj;
+  };
+  void InvalidateAdj(uint32_t v) {
+    if (v < adj_.size() && adj_[v].size != kNoAdj) {
+      adj_live_ -= adj_[v].size;
+      adj_[v].size = kNoAdj;
+    }
+  }
+  void StoreAdj(uint32_t v, uint32_t m) const;
 
   // Vertices.
   std::vector<Vec3> points_;
@@ -248,6 +295,14 @@ class Delaunay3 {
   uint32_t EdgeTableFor(size_t num_tets);
   mutable std::vector<uint32_t> vertex_mark_;
   mutable uint32_t vertex_stamp_ = 0;
+  // Vertex-query scratch (WalkStar); sizes only grow.
+  mutable std::vector<TetId> star_buf_;
+  mutable std::vector<VertexId> nbr_buf_;
+  mutable std::vector<TetId> nbr_tet_buf_;
+  bool cache_neighbors_ = false;
+  mutable std::vector<AdjEntry> adj_;
+  mutable std::vector<VertexId> adj_pool_;
+  mutable size_t adj_live_ = 0;  // entries of adj_pool_ still referenced
   bool report_cavity_vertices_ = true;
   Stats stats_;
 };

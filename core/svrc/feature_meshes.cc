@@ -14,6 +14,9 @@ using geom::Vec3;
 OmegaMesh::OmegaMesh(const Vec3& center, double half_side) : half_side_(half_side) {
   cube_.Add(center - Vec3(half_side, half_side, half_side));
   cube_.Add(center + Vec3(half_side, half_side, half_side));
+  // The refiner's cell searches (Destroy's 𝒱, PropagateLocation, nearest
+  // vertex) ask for the same cells' neighbours many times between insertions.
+  dt_.set_cache_neighbors(true);
 }
 
 Vec3 OmegaMesh::Corner(int i) const {
@@ -47,18 +50,17 @@ bool OmegaMesh::InsideCube(const Vec3& p) const {
   return true;
 }
 
-const Vec3& OmegaMesh::CachedCircumcenter(TetId t) const {
+const OmegaMesh::CcEntry& OmegaMesh::CachedCircumcenter(TetId t) const {
   const uint32_t i = t.value();
-  if (cc_.size() <= i) {
-    cc_.resize(dt_.TetCapacity() + 64);
-    cc_gen_.resize(dt_.TetCapacity() + 64, 0);
-  }
+  if (cc_.size() <= i) cc_.resize(dt_.TetCapacity() + 64);
   const uint32_t g = dt_.Generation(t) + 1;
-  if (cc_gen_[i] != g) {
-    cc_[i] = dt_.Circumcenter(t);
-    cc_gen_[i] = g;
+  CcEntry& e = cc_[i];
+  if (e.gen != g) {
+    e.cc = dt_.Circumcenter(t);
+    e.gen = g;
+    e.inside = InsideCube(e.cc);
   }
-  return cc_[i];
+  return e;
 }
 
 Vec3 OmegaMesh::FarPoint(TetId g) const {
@@ -109,34 +111,29 @@ CellSize OmegaMesh::Size(VertexId v) const {
   CellSize out;
   const Vec3& pv = dt_.Point(v);
   out.hint = dt_.VertexTet(v);
-  dt_.Star(v, &star_);
-  // r_v = half the shortest Delaunay edge at v (Lemma 3), read off the star
-  // (one star walk instead of Delaunay3::InRadius' second one).
+  // One star walk gives the star, the neighbours and, per neighbour, a tet on
+  // the ring around the edge (the first star tet containing it).
+  const delaunay::Delaunay3::StarAndNeighbors sn = dt_.StarAndNeighborsView(v);
+  // r_v = half the shortest Delaunay edge at v (Lemma 3).
   double shortest2 = HUGE_VAL;
-  for (TetId t : star_) {
-    for (int i = 0; i < 4; ++i) {
-      const VertexId w = dt_.TetVertex(t, i);
-      if (w == v || w == delaunay::kInfiniteVertex) continue;
-      shortest2 = std::min(shortest2, geom::Dist2(dt_.Point(w), pv));
-    }
-  }
+  for (VertexId w : sn.neighbors) shortest2 = std::min(shortest2, geom::Dist2(dt_.Point(w), pv));
   out.inradius = 0.5 * std::sqrt(shortest2);
   bool needs_clip = false;
   double best = -1;
-  for (TetId t : star_) {
+  for (TetId t : sn.star) {
     if (dt_.IsGhost(t)) {
       needs_clip = true;
       break;
     }
-    const Vec3& cc = CachedCircumcenter(t);
-    if (!InsideCube(cc)) {
+    const CcEntry& e = CachedCircumcenter(t);
+    if (!e.inside) {
       needs_clip = true;
       break;
     }
-    const double d = geom::Dist(cc, pv);
+    const double d = geom::Dist(e.cc, pv);
     if (d > best) {
       best = d;
-      out.corner = cc;
+      out.corner = e.cc;
       out.hint = t;
     }
   }
@@ -149,24 +146,17 @@ CellSize OmegaMesh::Size(VertexId v) const {
   out.clipped = true;
   out.hint = dt_.VertexTet(v);
   best = -1;
-  dt_.Neighbors(v, &nbrs_);
-  for (VertexId u : nbrs_) {
+  for (size_t k = 0; k < sn.neighbors.size(); ++k) {
+    const VertexId u = sn.neighbors[k];
     // The ring of tets around edge vu, walked across the faces containing vu.
-    TetId t0;
-    for (TetId t : star_) {
-      for (int i = 0; i < 4; ++i) {
-        if (dt_.TetVertex(t, i) == u) t0 = t;
-      }
-      if (t0.valid()) break;
-    }
-    if (!t0.valid()) continue;
+    const TetId t0 = sn.neighbor_tet[k];
     poly_.clear();
     TetId t = t0, prev;
     for (int guard = 0; guard < 1024; ++guard) {
       if (dt_.IsGhost(t)) {
         poly_.push_back(FarPoint(t));
       } else {
-        poly_.push_back(CachedCircumcenter(t));
+        poly_.push_back(CachedCircumcenter(t).cc);
       }
       // The two faces of t containing v and u are opposite its other two vertices.
       TetId next;

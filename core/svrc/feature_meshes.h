@@ -77,9 +77,15 @@ class OmegaMesh {
   bool InsideCube(const geom::Vec3& p) const;
   // Appends the polygon clipped to the cube to `out` (vertices only).
   void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
-  // Circumcentre of finite tet t, cached per (slot, generation): each tet is in
-  // four stars and Size() is called for every cavity vertex (Figure 3.5).
-  const geom::Vec3& CachedCircumcenter(TetId t) const;
+  // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
+  // generation): each tet is in four stars and Size() is called for every
+  // cavity vertex (Figure 3.5). One 32-byte record per slot: one cache line.
+  struct CcEntry {
+    geom::Vec3 cc;
+    uint32_t gen = 0;     // generation + 1 of the cached value; 0: none
+    uint32_t inside = 0;  // InsideCube(cc)
+  };
+  const CcEntry& CachedCircumcenter(TetId t) const;
   // A far point on the Voronoi ray of ghost tet g (outside Ω).
   geom::Vec3 FarPoint(TetId ghost) const;
 
@@ -91,11 +97,8 @@ class OmegaMesh {
   std::vector<EventHandle> skinny_event_;
   std::vector<EventHandle> unresolved_event_;
   mutable Stats stats_;
-  mutable std::vector<geom::Vec3> cc_;
-  mutable std::vector<uint32_t> cc_gen_;  // generation + 1 of the cached value; 0: none
+  mutable std::vector<CcEntry> cc_;
   // Scratch.
-  mutable std::vector<TetId> star_;
-  mutable std::vector<VertexId> nbrs_;
   mutable std::vector<geom::Vec3> poly_, poly2_;
 };
 

@@ -4,7 +4,7 @@
 #   svrc_delaunay3_cgal_tests tets equal CGAL's Delaunay_triangulation_3 on 10^5
 #                             points (CGAL header-only, tests only; label slow)
 svrc_add_test_suite(NAME svrc_delaunay3_tests
-  SOURCES delaunay3_test.cc point_set_test.cc
+  SOURCES delaunay3_test.cc delaunay3_queries_test.cc point_set_test.cc
   LIBS svrc_delaunay3 svrc_test_support
   LABELS core
   TIMEOUT 300)
