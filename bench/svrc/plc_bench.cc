@@ -85,6 +85,16 @@ struct ProcessResult {
   long peak_rss_kib = 0;  // ru_maxrss of the child
 };
 
+// The running child's process group, for the SIGINT/SIGTERM handler: a
+// benchmark that is interrupted must not leave a mesher running.
+volatile sig_atomic_t g_child_group = 0;
+
+void KillChildAndExit(int sig) {
+  if (g_child_group > 0) kill(-g_child_group, SIGKILL);
+  signal(sig, SIG_DFL);
+  raise(sig);
+}
+
 // fork/exec `argv` in `dir` (stdout, stderr to files there), RLIMIT_AS =
 // mem_limit bytes (0: none), its own process group; SIGKILL to the group
 // after `timeout_s`. Polls wait4(WNOHANG) so a hung child cannot hang us.
@@ -116,6 +126,7 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const fs::path& d
     _exit(127);
   }
   setpgid(pid, pid);
+  g_child_group = pid;
   r.started = true;
   int status = 0;
   rusage ru{};
@@ -136,6 +147,7 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const fs::path& d
     std::this_thread::sleep_for(sleep_for);
     sleep_for = std::min(sleep_for * 2, std::chrono::microseconds(20000));
   }
+  g_child_group = 0;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.cpu_s = ru.ru_utime.tv_sec + ru.ru_utime.tv_usec * 1e-6 + ru.ru_stime.tv_sec +
             ru.ru_stime.tv_usec * 1e-6;
@@ -568,6 +580,9 @@ int Main(int argc, char** argv) {
     }
   }
   if (o.bounds.empty()) return Usage(argv[0]);
+  signal(SIGINT, KillChildAndExit);
+  signal(SIGTERM, KillChildAndExit);
+  signal(SIGHUP, KillChildAndExit);
 
   std::vector<Input> inputs;
   std::vector<GeneratedInput> generated = plc::families::StandardInputs();
