@@ -569,24 +569,18 @@ uint32_t Delaunay3::WalkStar(uint32_t v, uint32_t* num_neighbors) const {
     nbr_buf_.resize(64);
     nbr_tet_buf_.resize(64);
   }
-  const uint32_t tstamp = FreshStamps(1);
-  uint32_t* tmark = tet_mark_.data();
-  uint32_t vstamp = 0;
-  if (kNeighbors) {
-    if (++vertex_stamp_ == 0) {
-      std::fill(vertex_mark_.begin(), vertex_mark_.end(), 0);
-      vertex_stamp_ = 1;
-    }
-    if (vertex_mark_.size() < points_.size()) {
-      vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
-    }
-    vstamp = vertex_stamp_;
+  // Visited bits, all zero between walks (cleared from the lists at the end):
+  // 1 bit per tet slot keeps the set in L1/L2, unlike 32-bit stamps.
+  if (tet_bits_.size() * 64 < TetCapacity()) tet_bits_.resize(TetCapacity() / 64 + 1, 0);
+  if (kNeighbors && vertex_bits_.size() * 64 < points_.size()) {
+    vertex_bits_.resize(points_.size() / 64 + 1, 0);
   }
-  uint32_t* vmark = vertex_mark_.data();
+  uint64_t* tbits = tet_bits_.data();
+  uint64_t* vbits = vertex_bits_.data();
   const uint32_t* tets = tets_.data();
   TetId* star = star_buf_.data();
   star[n++] = TetId(t0);
-  tmark[t0] = tstamp;
+  tbits[t0 >> 6] |= uint64_t{1} << (t0 & 63);
   for (uint32_t k = 0; k < n; ++k) {
     const uint32_t t = star[k].value();
     const uint32_t* tv = &tets[8 * t];
@@ -602,19 +596,23 @@ uint32_t Delaunay3::WalkStar(uint32_t v, uint32_t* num_neighbors) const {
     for (int f = 0; f < 4; ++f) {
       const uint32_t w = tv[f];
       if (w == v) continue;  // the face opposite v does not contain v
-      if (kNeighbors && w != kInf && vmark[w] != vstamp) {
-        vmark[w] = vstamp;
+      if (kNeighbors && w != kInf && !(vbits[w >> 6] & (uint64_t{1} << (w & 63)))) {
+        vbits[w >> 6] |= uint64_t{1} << (w & 63);
         nbr_buf_[m] = VertexId(w);
         nbr_tet_buf_[m] = TetId(t);
         ++m;
       }
       const uint32_t u = tv[4 + f] >> 2;
-      if (tmark[u] != tstamp) {
-        tmark[u] = tstamp;
+      if (!(tbits[u >> 6] & (uint64_t{1} << (u & 63)))) {
+        tbits[u >> 6] |= uint64_t{1} << (u & 63);
         __builtin_prefetch(&tets[8 * u]);
         star[n++] = TetId(u);
       }
     }
+  }
+  for (uint32_t k = 0; k < n; ++k) tbits[star[k].value() >> 6] = 0;
+  if (kNeighbors) {
+    for (uint32_t k = 0; k < m; ++k) vbits[nbr_buf_[k].value() >> 6] = 0;
   }
   if (num_neighbors != nullptr) *num_neighbors = m;
   return n;

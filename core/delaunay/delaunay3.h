@@ -239,9 +239,9 @@ class Delaunay3 {
   void LinkAroundApex(uint32_t apex);
   // The star walk behind every vertex query: fills star_buf_ (BFS order from
   // VertexTet(v)) and, with kNeighbors, nbr_buf_ / nbr_tet_buf_; returns the
-  // star size. Visited sets are stamps in tet_mark_ / vertex_mark_ (measured
-  // faster than small hash sets: the stamp lines are hot after the first
-  // query of a neighbourhood).
+  // star size. Visited sets are bitsets over tet slots / vertices, zero
+  // between walks (1/32 of the memory of 32-bit stamps, measured no slower;
+  // small hash sets were measured slower).
   template <bool kNeighbors>
   uint32_t WalkStar(uint32_t v, uint32_t* num_neighbors) const;
 
@@ -299,6 +299,7 @@ class Delaunay3 {
   mutable std::vector<TetId> star_buf_;
   mutable std::vector<VertexId> nbr_buf_;
   mutable std::vector<TetId> nbr_tet_buf_;
+  mutable std::vector<uint64_t> tet_bits_, vertex_bits_;
   bool cache_neighbors_ = false;
   mutable std::vector<AdjEntry> adj_;
   mutable std::vector<VertexId> adj_pool_;
