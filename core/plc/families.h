@@ -1,7 +1,7 @@
 // Generated PLC families for tests and benchmarks (issues #5 and #6): boxes
 // with internal facets, holes, cavities and tunnels, nested regions, free
-// segments and isolated points, the two-skew-lines input of thesis §1 (whose
-// Delaunay triangulation is quadratic) and crease inputs (facets and segments
+// segments and isolated points, two skew lines of points (Delaunay complexity
+// Ω(N²), thesis §1.5.1) and crease inputs (facets and segments
 // meeting at small angles, thesis Definitions 4-5). Every family is
 // deterministic and passes PreparePlc (validate.h); coordinates are chosen so
 // that planarity and incidences hold exactly in doubles (docs/plc.md §2, §4).
@@ -49,8 +49,8 @@ Plc BoxWithTunnel(double side);
 // BoxWithTunnel is the closed variant whose facets with holes bound the volume.
 Plc InternalFacetWithHole(int hole_sides, double hole_radius);
 
-// Unit box with `num_segments` free segments (segment i lies in the plane
-// z = (i+1)/(num_segments+1), so no two meet) and `num_points` isolated
+// Unit box with `num_segments` free segments (segment i, marker 10+i, lies in
+// the plane z = (i+1)/(num_segments+1), so no two meet) and `num_points` isolated
 // points, uniform in [0.1, 0.9]^3 from std::mt19937_64(seed) (53-bit
 // mantissas taken from the raw integers, so identical on every platform).
 Plc FreeSegmentsAndPoints(int num_segments, int num_points, uint64_t seed);
