@@ -2,8 +2,12 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cstdlib>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -26,6 +30,22 @@ using google::protobuf::util::TimeUtil;
 
 google::protobuf::Timestamp ToTimestamp(absl::Time t) {
   return TimeUtil::NanosecondsToTimestamp(absl::ToUnixNanos(t));
+}
+
+// Waits on `cv` (with `lock` held) until `pred` holds or `timeout` has
+// passed; returns pred(). An infinite or absurdly long timeout (e.g.
+// --grace-period=inf) waits without one: wait_for(now + huge) would
+// overflow the clock. Zero or negative: just evaluates pred.
+template <typename Pred>
+bool WaitFor(std::condition_variable& cv, std::unique_lock<std::mutex>& lock,
+             absl::Duration timeout, Pred pred) {
+  if (timeout >= absl::Hours(24 * 365 * 100)) {
+    cv.wait(lock, pred);
+    return true;
+  }
+  const auto deadline = std::chrono::steady_clock::now() +
+                        absl::ToChronoNanoseconds(std::max(timeout, absl::ZeroDuration()));
+  return cv.wait_until(lock, deadline, pred);
 }
 
 v1::JobState StateFor(const absl::Status& status) {
@@ -113,7 +133,7 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request, const s
 
   const std::string request_key = RequestKey(owner, request.request_id());
   // Checks done before and again after the input is stored (outside the lock).
-  auto admit = [&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) -> absl::StatusOr<const JobRecord*> {
+  auto admit = [&]() -> absl::StatusOr<const JobRecord*> {  // mu_ held
     if (!accepting_) return absl::UnavailableError("server is shutting down; not accepting jobs");
     if (!request.request_id().empty()) {
       auto it = by_request_id_.find(request_key);
@@ -134,7 +154,7 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request, const s
   };
   std::string id;
   {
-    absl::MutexLock lock(&mu_);
+    std::scoped_lock lock(mu_);
     absl::StatusOr<const JobRecord*> existing = admit();
     if (!existing.ok()) return existing.status();
     if (*existing != nullptr) {
@@ -154,7 +174,7 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request, const s
       return absl::UnavailableError(absl::StrCat("cannot store the input: ", s.message()));
     }
   }
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   {
     absl::StatusOr<const JobRecord*> existing = admit();
     if (!existing.ok() || *existing != nullptr) {
@@ -215,7 +235,7 @@ absl::StatusOr<v1::Job> JobManager::Submit(v1::SubmitJobRequest request, const s
 }
 
 absl::StatusOr<v1::Job> JobManager::Get(const std::string& job_id, const std::string& owner) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   JobRecord* rec = Find(job_id, owner);
   if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   return rec->job;
@@ -236,7 +256,7 @@ absl::StatusOr<v1::ListJobsResponse> JobManager::List(const v1::ListJobsRequest&
     return false;
   };
   v1::ListJobsResponse out;
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   for (auto it = order_.lower_bound(start); it != order_.end(); ++it) {
     const JobRecord& rec = *jobs_.at(it->second);
     const v1::Job& job = rec.job;
@@ -251,7 +271,7 @@ absl::StatusOr<v1::ListJobsResponse> JobManager::List(const v1::ListJobsRequest&
 }
 
 absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& job_id, const std::string& owner) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   JobRecord* rec = Find(job_id, owner);
   if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   if (api::IsTerminal(rec->job.state())) return rec->job;
@@ -267,7 +287,7 @@ absl::StatusOr<v1::Job> JobManager::Cancel(const std::string& job_id, const std:
 }
 
 absl::Status JobManager::Delete(const std::string& job_id, const std::string& owner) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   JobRecord* rec = Find(job_id, owner);
   if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   auto it = jobs_.find(job_id);
@@ -289,7 +309,7 @@ absl::Status JobManager::Delete(const std::string& job_id, const std::string& ow
 
 absl::StatusOr<uint64_t> JobManager::Subscribe(const std::string& job_id, Listener listener,
                                                const std::string& owner) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   JobRecord* rec = Find(job_id, owner);
   if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const uint64_t token = next_token_++;
@@ -302,14 +322,14 @@ absl::StatusOr<uint64_t> JobManager::Subscribe(const std::string& job_id, Listen
 }
 
 void JobManager::Unsubscribe(const std::string& job_id, uint64_t token) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   auto it = jobs_.find(job_id);
   if (it != jobs_.end()) it->second->listeners.erase(token);
 }
 
 absl::StatusOr<StoredResult> JobManager::Result(const std::string& job_id,
                                                const std::string& owner) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   JobRecord* rec = Find(job_id, owner);
   if (rec == nullptr) return absl::NotFoundError(absl::StrCat("no job ", job_id));
   const v1::Job& job = rec->job;
@@ -327,12 +347,12 @@ absl::StatusOr<StoredResult> JobManager::Result(const std::string& job_id,
 }
 
 bool JobManager::accepting() const {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   return accepting_;
 }
 
 int JobManager::running() const {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   return running_;
 }
 
@@ -394,7 +414,7 @@ void JobManager::CheckMemory(JobRecord* rec) {
 
 void JobManager::OnProgress(JobRecord* rec, const core::Progress& progress) {
   CheckMemory(rec);
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   v1::Progress* p = rec->job.mutable_progress();
   const bool phase_changed = p->phase() != progress.phase;
   p->set_phase(progress.phase);
@@ -414,7 +434,7 @@ void JobManager::RunJob(const std::string& job_id) {
   JobRecord* rec = nullptr;
   v1::SubmitJobRequest request;
   {
-    absl::MutexLock lock(&mu_);
+    std::scoped_lock lock(mu_);
     auto it = jobs_.find(job_id);
     if (it == jobs_.end() || it->second->job.state() != v1::QUEUED) return;
     rec = it->second.get();
@@ -464,7 +484,7 @@ void JobManager::RunJob(const std::string& job_id) {
         "the job exceeded the server's per-job memory budget of ", options_.max_job_memory_bytes,
         " bytes (it held ", rec->memory.peak.load(), " bytes)"));
   }
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   --running_;
   rec->job.mutable_progress()->set_elapsed_seconds(absl::ToDoubleSeconds(absl::Now() - rec->started));
   if (status.ok()) {
@@ -473,6 +493,9 @@ void JobManager::RunJob(const std::string& job_id) {
     *rec->job.mutable_result() = std::move(info);
   }
   Finish(rec, status);
+  // Shutdown may be waiting for running_ == 0. Notified under the lock, after
+  // Finish: once Shutdown sees 0 the job's FINISHED record is journaled.
+  state_changed_.notify_all();
 }
 
 absl::Status JobManager::Execute(JobRecord* rec, const v1::SubmitJobRequest& request,
@@ -481,7 +504,7 @@ absl::Status JobManager::Execute(JobRecord* rec, const v1::SubmitJobRequest& req
   auto phase = [&](const char* name) {
     core::Progress p;
     {
-      absl::MutexLock lock(&mu_);
+      std::scoped_lock lock(mu_);
       const v1::Progress& cur = rec->job.progress();
       p.vertices = cur.vertices();
       p.queue_size = cur.queue_size();
@@ -537,9 +560,10 @@ absl::Status JobManager::Execute(JobRecord* rec, const v1::SubmitJobRequest& req
 
 void JobManager::JanitorLoop() {
   absl::Time last_sweep = absl::Now();
-  absl::MutexLock lock(&mu_);
+  std::unique_lock lock(mu_);
   while (!stopped_) {
-    mu_.AwaitWithTimeout(absl::Condition(&stopped_), options_.janitor_interval);
+    // Woken early by Shutdown (stopped_ is set then notified).
+    WaitFor(state_changed_, lock, options_.janitor_interval, [this] { return stopped_; });
     if (stopped_) break;
     const absl::Time now = absl::Now();
     std::vector<std::string> expired;
@@ -648,7 +672,7 @@ void JobManager::Recover() {
   }
   const absl::Time now = absl::Now();
   int requeued = 0, failed = 0, kept = 0;
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   for (const std::string& id : order) {
     auto it = replayed.find(id);
     if (it == replayed.end() || jobs_.contains(id)) continue;
@@ -731,14 +755,14 @@ void JobManager::Recover() {
 
 void JobManager::Shutdown(absl::Duration grace) {
   {
-    absl::MutexLock lock(&mu_);
+    std::scoped_lock lock(mu_);
     if (stopped_) return;
     accepting_ = false;
     draining_ = journal_ != nullptr;
   }
   std::vector<std::string> queued = queue_->Close();
   {
-    absl::MutexLock lock(&mu_);
+    std::unique_lock lock(mu_);
     for (const std::string& id : queued) {
       auto it = jobs_.find(id);
       // With a journal, queued jobs stay queued for the next start.
@@ -748,8 +772,8 @@ void JobManager::Shutdown(absl::Duration grace) {
     }
     ServerLog().info("shutdown: {} queued jobs cancelled, waiting up to {} for {} running",
                      queued.size(), absl::FormatDuration(grace), running_);
-    if (!mu_.AwaitWithTimeout(absl::Condition(+[](int* running) { return *running == 0; }, &running_),
-                              grace)) {
+    // RunJob notifies state_changed_ after every --running_.
+    if (!WaitFor(state_changed_, lock, grace, [this] { return running_ == 0; })) {
       for (auto& [id, rec] : jobs_) {
         if (rec->job.state() == v1::RUNNING) {
           ServerLog().info("job {}: cancelled at the end of the shutdown grace period", id);
@@ -762,9 +786,10 @@ void JobManager::Shutdown(absl::Duration grace) {
   }
   workers_->Join();
   {
-    absl::MutexLock lock(&mu_);
+    std::scoped_lock lock(mu_);
     stopped_ = true;
   }
+  state_changed_.notify_all();  // the janitor leaves its wait at once
   if (janitor_.joinable()) janitor_.join();
 }
 

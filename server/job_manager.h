@@ -8,19 +8,19 @@
 // DESIGN.md "Data flow".
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/random/random.h"
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "core/api.h"
 #include "server/job_queue.h"
@@ -101,23 +101,28 @@ class JobManager {
  private:
   struct JobRecord;
 
-  // The job `job_id` if it exists and belongs to `owner`.
-  JobRecord* Find(const std::string& job_id, const std::string& owner)
-      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Functions marked "mu_ held" must be called with mu_ locked (GCC has no
+  // thread-safety analysis and std::mutex carries no capability attribute,
+  // so this is a comment, not an annotation).
+
+  // The job `job_id` if it exists and belongs to `owner`. mu_ held.
+  JobRecord* Find(const std::string& job_id, const std::string& owner);
   // Rebuilds the job table from the journal (constructor, before the workers).
   void Recover();
   // Journal helpers; failures are logged (the in-memory state stays right).
-  void JournalAppend(v1::JournalRecord record, bool sync) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  v1::JournalRecord SnapshotOf(const JobRecord& rec) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  void Compact() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // mu_ held.
+  void JournalAppend(v1::JournalRecord record, bool sync);
+  v1::JournalRecord SnapshotOf(const JobRecord& rec) const;  // mu_ held
+  void Compact();                                             // mu_ held
   static std::string RequestKey(const std::string& owner, const std::string& request_id);
 
   void RunJob(const std::string& job_id);
   absl::Status Execute(JobRecord* rec, const v1::SubmitJobRequest& request,
                        StoredResult* stored, v1::ResultInfo* info);
-  // Moves a job to a terminal state from `status` and notifies.
-  void Finish(JobRecord* rec, const absl::Status& status) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  void Notify(JobRecord* rec) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Moves a job to a terminal state from `status` and notifies. mu_ held.
+  void Finish(JobRecord* rec, const absl::Status& status);
+  // Calls the job's listeners with its current state. mu_ held.
+  void Notify(JobRecord* rec);
   void OnProgress(JobRecord* rec, const core::Progress& progress);
   // Cancels a running job whose accounted heap exceeds max_job_memory_bytes.
   void CheckMemory(JobRecord* rec);
@@ -129,17 +134,25 @@ class JobManager {
   std::unique_ptr<Journal> journal_;  // null: nothing survives a restart
   std::string crash_input_name_;  // test hook SVRC_TEST_CRASH_ON_INPUT (docs/service.md)
 
-  mutable absl::Mutex mu_;
-  absl::flat_hash_map<std::string, std::unique_ptr<JobRecord>> jobs_ ABSL_GUARDED_BY(mu_);
-  std::map<uint64_t, std::string> order_ ABSL_GUARDED_BY(mu_);  // submission seq -> id
-  absl::flat_hash_map<std::string, std::string> by_request_id_ ABSL_GUARDED_BY(mu_);
-  absl::BitGen bitgen_ ABSL_GUARDED_BY(mu_);
-  uint64_t next_seq_ ABSL_GUARDED_BY(mu_) = 1;
-  uint64_t next_token_ ABSL_GUARDED_BY(mu_) = 1;
-  int running_ ABSL_GUARDED_BY(mu_) = 0;
-  bool accepting_ ABSL_GUARDED_BY(mu_) = true;
-  bool stopped_ ABSL_GUARDED_BY(mu_) = false;
-  bool draining_ ABSL_GUARDED_BY(mu_) = false;  // Shutdown with a journal: jobs stay queued
+  // std::mutex, not absl::Mutex: TSan intercepts pthread mutexes and
+  // condition variables, while Debian's Abseil is not TSan-built
+  // (docs/service.md "TSan"). mu_ guards every field from here to draining_,
+  // and every JobRecord in jobs_ except its atomics (memory,
+  // memory_exceeded, cancel), which the running worker also reads unlocked.
+  mutable std::mutex mu_;
+  // Notified (all) whenever running_ drops and when stopped_ is set:
+  // Shutdown waits for running_ == 0, the janitor sleeps until stopped_.
+  std::condition_variable state_changed_;
+  absl::flat_hash_map<std::string, std::unique_ptr<JobRecord>> jobs_;
+  std::map<uint64_t, std::string> order_;  // submission seq -> id
+  absl::flat_hash_map<std::string, std::string> by_request_id_;
+  absl::BitGen bitgen_;
+  uint64_t next_seq_ = 1;
+  uint64_t next_token_ = 1;
+  int running_ = 0;
+  bool accepting_ = true;
+  bool stopped_ = false;
+  bool draining_ = false;  // Shutdown with a journal: jobs stay queued
 
   std::unique_ptr<WorkerPool> workers_;
   std::thread janitor_;

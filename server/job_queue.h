@@ -3,15 +3,15 @@
 // "Deployment and scale") is a new implementation, not a rewrite.
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <deque>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/status/status.h"
-#include "absl/synchronization/mutex.h"
 
 namespace svrc::server {
 
@@ -44,9 +44,13 @@ class InMemoryJobQueue final : public JobQueue {
 
  private:
   const size_t capacity_;
-  mutable absl::Mutex mu_;
-  std::deque<std::string> ids_ ABSL_GUARDED_BY(mu_);
-  bool closed_ ABSL_GUARDED_BY(mu_) = false;
+  // std::mutex, not absl::Mutex: TSan intercepts pthread mutexes, while
+  // Debian's Abseil is not TSan-built (docs/service.md "TSan").
+  mutable std::mutex mu_;
+  // Signalled when ids_ gains an id (one waiter) or the queue closes (all).
+  std::condition_variable not_empty_or_closed_;
+  std::deque<std::string> ids_;  // guarded by mu_
+  bool closed_ = false;           // guarded by mu_
 };
 
 }  // namespace svrc::server

@@ -149,13 +149,13 @@ absl::StatusOr<std::unique_ptr<Journal>> Journal::Open(const std::string& data_d
     ::close(fd);
     return s;
   }
-  absl::MutexLock lock(&j->mu_);
+  std::scoped_lock lock(j->mu_);
   j->fd_ = fd;
   return j;
 }
 
 Journal::~Journal() {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   if (fd_ >= 0) ::close(fd_);
 }
 
@@ -163,7 +163,7 @@ std::vector<v1::JournalRecord> Journal::TakeReplayed() { return std::move(replay
 
 absl::Status Journal::Append(const v1::JournalRecord& record, bool sync) {
   const std::string framed = Frame(record);
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   if (fd_ < 0) return absl::FailedPreconditionError("journal closed");
   // One write(2) per record on an O_APPEND-less fd we alone own; a crash
   // mid-write leaves a torn tail that Open drops.
@@ -176,7 +176,7 @@ absl::Status Journal::Append(const v1::JournalRecord& record, bool sync) {
 absl::Status Journal::Rewrite(const std::vector<v1::JournalRecord>& records) {
   std::string bytes;
   for (const v1::JournalRecord& r : records) bytes += Frame(r);
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   const std::string path = LogPath();
   if (absl::Status s = WriteFileAtomically(path, bytes); !s.ok()) return s;
   SyncDir(journal_dir_);
@@ -193,7 +193,7 @@ absl::Status Journal::Rewrite(const std::vector<v1::JournalRecord>& records) {
 }
 
 uint64_t Journal::appended_since_rewrite() const {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   return appended_;
 }
 

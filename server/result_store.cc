@@ -87,7 +87,7 @@ absl::StatusOr<std::unique_ptr<DiskResultStore>> DiskResultStore::Open(const std
         absl::StrCat("cannot create result directory ", dir.string(), ": ", ec.message()));
   }
   std::unique_ptr<DiskResultStore> store(new DiskResultStore(dir.string(), quota_bytes));
-  absl::MutexLock lock(&store->mu_);
+  std::scoped_lock lock(store->mu_);
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     if (name.rfind(kTmpPrefix, 0) == 0) {  // a write interrupted by a crash
@@ -136,7 +136,7 @@ absl::StatusOr<StoredResult> DiskResultStore::Put(const std::string& key, std::s
   if (!ValidKey(key)) return absl::InvalidArgumentError(absl::StrCat("bad result key '", key, "'"));
   uint64_t tmp_id;
   {
-    absl::MutexLock lock(&mu_);
+    std::scoped_lock lock(mu_);
     if (index_.count(key)) return absl::AlreadyExistsError(absl::StrCat("result ", key, " exists"));
     if (quota_ > 0 && used_ + reserved_ + bytes.size() > quota_) {
       return absl::ResourceExhaustedError(absl::StrCat(
@@ -156,7 +156,7 @@ absl::StatusOr<StoredResult> DiskResultStore::Put(const std::string& key, std::s
     if (!s.ok()) ::unlink(DataPath(key).c_str());
   }
   SyncDir(dir_);
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   reserved_ -= bytes.size();
   if (!s.ok()) return s;
   index_[key] = result;
@@ -165,7 +165,7 @@ absl::StatusOr<StoredResult> DiskResultStore::Put(const std::string& key, std::s
 }
 
 absl::StatusOr<StoredResult> DiskResultStore::Stat(const std::string& key) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   auto it = index_.find(key);
   if (it == index_.end()) return absl::NotFoundError(absl::StrCat("no result ", key));
   return it->second;
@@ -199,7 +199,7 @@ absl::StatusOr<std::string> DiskResultStore::Read(const std::string& key, uint64
 }
 
 absl::Status DiskResultStore::Delete(const std::string& key) {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   auto it = index_.find(key);
   if (it == index_.end()) return absl::OkStatus();
   used_ -= it->second.size;
@@ -210,7 +210,7 @@ absl::Status DiskResultStore::Delete(const std::string& key) {
 
 std::vector<std::string> DiskResultStore::RemoveOlderThan(absl::Time cutoff) {
   std::vector<std::string> removed;
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   for (auto it = index_.begin(); it != index_.end();) {
     if (it->second.created < cutoff) {
       removed.push_back(it->first);
@@ -225,7 +225,7 @@ std::vector<std::string> DiskResultStore::RemoveOlderThan(absl::Time cutoff) {
 }
 
 uint64_t DiskResultStore::UsedBytes() {
-  absl::MutexLock lock(&mu_);
+  std::scoped_lock lock(mu_);
   return used_;
 }
 

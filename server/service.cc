@@ -1,12 +1,11 @@
 #include "server/service.h"
 
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/strings/str_cat.h"
-#include "absl/synchronization/mutex.h"
 #include "proto/convert.h"
 #include "server/log.h"
 #include "server/status_util.h"
@@ -124,7 +123,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
       : manager_(manager), job_id_(job_id) {
     if (!owner.ok()) {
       {
-        absl::MutexLock lock(&mu_);
+        std::scoped_lock lock(mu_);
         finished_ = true;
       }
       Finish(ToGrpcStatus(owner.status()));
@@ -136,7 +135,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
       Finish(ToGrpcStatus(token.status()));
       return;
     }
-    absl::MutexLock lock(&mu_);
+    std::scoped_lock lock(mu_);
     token_ = *token;
   }
 
@@ -144,7 +143,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
     if (!ok) return;  // the stream broke: OnDone follows
     bool finish = false;
     {
-      absl::MutexLock lock(&mu_);
+      std::scoped_lock lock(mu_);
       writing_ = false;
       if (pending_) {
         in_flight_ = std::move(*pending_);
@@ -165,7 +164,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
   void OnCancel() override {
     bool finish = false;
     {
-      absl::MutexLock lock(&mu_);
+      std::scoped_lock lock(mu_);
       finish = !finished_;
       finished_ = true;
     }
@@ -175,7 +174,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
   void OnDone() override {
     uint64_t token;
     {
-      absl::MutexLock lock(&mu_);
+      std::scoped_lock lock(mu_);
       token = token_;
     }
     if (token != 0) manager_->Unsubscribe(job_id_, token);
@@ -185,7 +184,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
  private:
   void Push(const v1::JobEvent& event) {
     {
-      absl::MutexLock lock(&mu_);
+      std::scoped_lock lock(mu_);
       if (finished_ || sent_terminal_) return;
       if (writing_) {
         pending_ = event;
@@ -201,7 +200,7 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
 
   void MaybeWrite() {
     {
-      absl::MutexLock lock(&mu_);
+      std::scoped_lock lock(mu_);
       if (!writing_) return;
     }
     StartWrite(&in_flight_);
@@ -209,13 +208,16 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
 
   JobManager* manager_;
   const std::string job_id_;
-  absl::Mutex mu_;
-  uint64_t token_ ABSL_GUARDED_BY(mu_) = 0;
+  // std::mutex (intercepted by TSan, unlike Debian's absl::Mutex). Taken
+  // inside the manager's lock (Push) and never the other way round. Guards
+  // token_, pending_, writing_, sent_terminal_ and finished_.
+  std::mutex mu_;
+  uint64_t token_ = 0;
   v1::JobEvent in_flight_;  // owned by gRPC while writing_
-  std::optional<v1::JobEvent> pending_ ABSL_GUARDED_BY(mu_);
-  bool writing_ ABSL_GUARDED_BY(mu_) = false;
-  bool sent_terminal_ ABSL_GUARDED_BY(mu_) = false;  // the last event queued is terminal
-  bool finished_ ABSL_GUARDED_BY(mu_) = false;
+  std::optional<v1::JobEvent> pending_;
+  bool writing_ = false;
+  bool sent_terminal_ = false;  // the last event queued is terminal
+  bool finished_ = false;
 };
 
 // FetchResult: chunks read from the result store one at a time (a read of

@@ -2,7 +2,10 @@
 // blocked Pop() callers and hands back what was still queued.
 #include "server/job_queue.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <mutex>
 #include <thread>
 
 #include "gtest/gtest.h"
@@ -52,6 +55,39 @@ TEST(InMemoryJobQueueTest, CloseWakesPoppersAndReturnsTheRest) {
   for (std::thread& t : poppers) t.join();
   EXPECT_EQ(woke.load(), 3);
   EXPECT_EQ(q.Push("x").code(), absl::StatusCode::kUnavailable);
+}
+
+// Pop() waits on a condition variable: every Push must wake a blocked Pop
+// (a missing notify leaves the id queued and the popper asleep).
+TEST(InMemoryJobQueueTest, EachPushWakesABlockedPop) {
+  InMemoryJobQueue q(8);
+  std::mutex mu;
+  std::vector<std::string> got;
+  std::vector<std::thread> poppers;
+  for (int i = 0; i < 3; ++i) {
+    poppers.emplace_back([&] {
+      std::optional<std::string> id = q.Pop();
+      std::scoped_lock lock(mu);
+      got.push_back(id.value_or("<closed>"));
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // all three blocked
+  for (const char* id : {"a", "b", "c"}) {
+    ASSERT_TRUE(q.Push(id).ok());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  for (;;) {
+    {
+      std::scoped_lock lock(mu);
+      if (got.size() == 3 || std::chrono::steady_clock::now() > end) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  q.Close();  // frees any popper a lost wake-up left behind, so the joins end
+  for (std::thread& t : poppers) t.join();
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, (std::vector<std::string>{"a", "b", "c"}));
 }
 
 TEST(InMemoryJobQueueTest, CloseHandsBackQueuedIdsInOrder) {

@@ -8,9 +8,9 @@
 
 #include <chrono>
 #include <filesystem>
+#include <mutex>
 #include <thread>
 
-#include "absl/synchronization/mutex.h"
 #include "client/mesh_job.h"
 #include "client/remote_client.h"
 #include "core/codec/container.h"
@@ -404,17 +404,17 @@ TEST(ServiceTest, SigtermLetsRunningJobsFinishWithinTheGracePeriod) {
   absl::StatusOr<v1::Job> queued = c.Submit(NodeRequest(testing::RandomNodeFile(100, 19)));
   ASSERT_TRUE(job.ok() && queued.ok());
   WaitState(c, job->job_id(), v1::RUNNING);
-  absl::Mutex mu;
+  std::mutex mu;
   v1::JobState end = v1::JOB_STATE_UNSPECIFIED;
   std::thread watcher([&] {
     absl::StatusOr<v1::Job> done = c.Watch(job->job_id(), nullptr, /*reconnects=*/0);
-    absl::MutexLock l(&mu);
+    std::scoped_lock l(mu);
     if (done.ok()) end = done->state();
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   EXPECT_EQ(server.Terminate(60), 0) << server.Log();
   watcher.join();
-  absl::MutexLock l(&mu);
+  std::scoped_lock l(mu);
   EXPECT_EQ(end, v1::SUCCEEDED) << server.Log();  // finished, and the watcher heard it
   // The queued job is not cancelled: it stays queued in the journal for the
   // next start (tests/server/persistence_test.cc runs it there).

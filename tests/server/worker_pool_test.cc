@@ -3,10 +3,11 @@
 #include "server/worker_pool.h"
 
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <set>
 #include <thread>
 
-#include "absl/synchronization/mutex.h"
 #include "gtest/gtest.h"
 
 namespace svrc::server {
@@ -15,14 +16,15 @@ namespace {
 TEST(WorkerPoolTest, RunsNJobsConcurrently) {
   InMemoryJobQueue q(16);
   std::atomic<int> inside{0}, peak{0};
-  absl::Mutex mu;
+  std::mutex mu;
+  std::condition_variable released;
   bool release = false;
   WorkerPool pool(3, &q, [&](const std::string&) {
     const int now = inside.fetch_add(1) + 1;
     int p = peak.load();
     while (now > p && !peak.compare_exchange_weak(p, now)) {}
-    absl::MutexLock lock(&mu);
-    mu.Await(absl::Condition(&release));
+    std::unique_lock lock(mu);
+    released.wait(lock, [&] { return release; });
     inside.fetch_sub(1);
   });
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(q.Push(std::to_string(i)).ok());
@@ -33,9 +35,10 @@ TEST(WorkerPoolTest, RunsNJobsConcurrently) {
   EXPECT_EQ(pool.busy(), 3);
   EXPECT_EQ(q.Size(), 2u);  // two wait for a free worker
   {
-    absl::MutexLock lock(&mu);
+    std::scoped_lock lock(mu);
     release = true;
   }
+  released.notify_all();
   while (q.Size() > 0 || pool.busy() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   q.Close();
   pool.Join();
@@ -44,11 +47,11 @@ TEST(WorkerPoolTest, RunsNJobsConcurrently) {
 
 TEST(WorkerPoolTest, EveryJobRunsExactlyOnce) {
   InMemoryJobQueue q(1000);
-  absl::Mutex mu;
+  std::mutex mu;
   std::multiset<std::string> ran;
   {
     WorkerPool pool(4, &q, [&](const std::string& id) {
-      absl::MutexLock lock(&mu);
+      std::scoped_lock lock(mu);
       ran.insert(id);
     });
     for (int i = 0; i < 500; ++i) ASSERT_TRUE(q.Push(std::to_string(i)).ok());
