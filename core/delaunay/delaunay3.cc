@@ -59,6 +59,7 @@ void Delaunay3::Reserve(size_t num_vertices) {
   points_.reserve(num_vertices);
   global_ids_.reserve(num_vertices);
   vertex_tet_.reserve(num_vertices);
+  star_version_.reserve(num_vertices);
   const size_t tets = num_vertices * 7 + 64;
   tets_.reserve(8 * tets);
   tet_gen_.reserve(tets);
@@ -242,11 +243,13 @@ Delaunay3::InsertResult Delaunay3::Insert(const Vec3& p, uint32_t global_id, Tet
   points_.push_back(p);
   global_ids_.push_back(global_id);
   vertex_tet_.push_back(kFreeSlot);
+  star_version_.push_back(0);
   InsertResult r = InsertVertex(v, start, sos);
   if (r.outcome == InsertOutcome::kDuplicate) {
     points_.pop_back();
     global_ids_.pop_back();
     vertex_tet_.pop_back();
+    star_version_.pop_back();
   }
   return r;
 }
@@ -363,6 +366,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
     for (int i = 0; i < 4; ++i) {
       if (tv[i] != kInf) {
         vertex_tet_[tv[i]] = t;
+        ++star_version_[tv[i]];
         if (cache_neighbors_) InvalidateAdj(tv[i]);
       }
     }
@@ -468,6 +472,7 @@ Delaunay3::InsertResult Delaunay3::InsertPending(const Vec3& p, uint32_t global_
   points_.push_back(p);
   global_ids_.push_back(global_id);
   vertex_tet_.push_back(kFreeSlot);
+  star_version_.push_back(0);
   pending_.push_back(v);
   r.vertex = VertexId(v);
   r.outcome = InsertOutcome::kPending;
@@ -534,7 +539,10 @@ void Delaunay3::BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
     created_.push_back(TetId(t));
   }
   LinkAroundApex(kInf);
-  for (int i = 0; i < 4; ++i) vertex_tet_[tv[i]] = t0;
+  for (int i = 0; i < 4; ++i) {
+    vertex_tet_[tv[i]] = t0;
+    ++star_version_[tv[i]];
+  }
   last_tet_ = t0;
 }
 

@@ -144,6 +144,10 @@ class Delaunay3 {
   uint32_t GlobalId(VertexId v) const { return global_ids_[v.value()]; }
   // One live tet incident to v (kNoneTet while v is pending).
   TetId VertexTet(VertexId v) const { return TetId(vertex_tet_[v.value()]); }
+  // Changes whenever v's star changes (v is a vertex of a new tet); while it
+  // stays the same, so do VertexTet(v) and every vertex query about v (same
+  // results, same order). A key for caching what is computed from the star.
+  uint32_t StarVersion(VertexId v) const { return star_version_[v.value()]; }
 
   bool IsAlive(TetId t) const { return tets_[8 * t.value()] != kFreeSlot; }
   bool IsGhost(TetId t) const { return tets_[8 * t.value() + 3] == kInfiniteVertex.value(); }
@@ -263,6 +267,7 @@ class Delaunay3 {
   std::vector<Vec3> points_;
   std::vector<uint32_t> global_ids_;
   std::vector<uint32_t> vertex_tet_;
+  std::vector<uint32_t> star_version_;
   // Tets.
   // Index in tets_ of the neighbour slot named by the encoding 4t+f.
   static constexpr uint32_t NRef(uint32_t n) { return 8 * (n >> 2) + 4 + (n & 3); }

@@ -108,6 +108,19 @@ void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* sc
 
 CellSize OmegaMesh::Size(VertexId v) const {
   ++stats_.size_queries;
+  const uint32_t key = dt_.StarVersion(v) + 1;
+  if (v.value() < size_memo_.size() && size_memo_[v.value()].key == key) {
+    const CellSize& m = size_memo_[v.value()].size;
+    if (m.clipped) ++stats_.clipped_queries;
+    return m;
+  }
+  const CellSize out = ComputeSize(v);
+  if (size_memo_.size() <= v.value()) size_memo_.resize(dt_.NumVertices() + dt_.NumVertices() / 2 + 16);
+  size_memo_[v.value()] = {key, out};
+  return out;
+}
+
+CellSize OmegaMesh::ComputeSize(VertexId v) const {
   CellSize out;
   const Vec3& pv = dt_.Point(v);
   out.hint = dt_.VertexTet(v);

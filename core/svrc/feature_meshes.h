@@ -75,6 +75,7 @@ class OmegaMesh {
 
  private:
   bool InsideCube(const geom::Vec3& p) const;
+  CellSize ComputeSize(VertexId v) const;  // Size() without the memo
   // Appends the polygon clipped to the cube to `out` (vertices only).
   void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
   // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
@@ -98,6 +99,14 @@ class OmegaMesh {
   std::vector<EventHandle> unresolved_event_;
   mutable Stats stats_;
   mutable std::vector<CcEntry> cc_;
+  // Size() per vertex, valid while the vertex's star is unchanged
+  // (Delaunay3::StarVersion): the event loop asks again for cells that did
+  // not change (IsLive, Output, invariant checks).
+  struct SizeMemo {
+    uint32_t key = 0;  // StarVersion + 1 when computed; 0: none
+    CellSize size;
+  };
+  mutable std::vector<SizeMemo> size_memo_;
   // Scratch.
   mutable std::vector<geom::Vec3> poly_, poly2_;
 };

@@ -151,6 +151,40 @@ TEST(Delaunay3QueriesTest, CacheFollowsInsertions) {
   EXPECT_TRUE(cached.Validate(true).ok());
 }
 
+// StarVersion changes exactly for the vertices of new tets, and a vertex
+// whose version did not change answers every query as before.
+TEST(Delaunay3QueriesTest, StarVersionTracksStarChanges) {
+  const auto pts = RandomPoints(300, 25);
+  Delaunay3 dt;
+  for (uint32_t i = 0; i < 8; ++i) dt.Insert(pts[i], i);
+  ASSERT_TRUE(dt.Is3d());
+  std::vector<Reference> before;
+  std::vector<uint32_t> version;
+  for (uint32_t i = 8; i < pts.size(); ++i) {
+    before.clear();
+    version.clear();
+    for (uint32_t v = 0; v < dt.NumVertices(); ++v) {
+      before.push_back(ReferenceWalk(dt, VertexId(v)));
+      version.push_back(dt.StarVersion(VertexId(v)));
+    }
+    const auto r = dt.Insert(pts[i], i);
+    ASSERT_EQ(r.outcome, Delaunay3::InsertOutcome::kInserted);
+    std::vector<char> in_new(dt.NumVertices(), 0);
+    for (TetId t : r.created) {
+      for (int k = 0; k < 4; ++k) {
+        if (dt.TetVertex(t, k) != kInfiniteVertex) in_new[dt.TetVertex(t, k).value()] = 1;
+      }
+    }
+    for (uint32_t v = 0; v + 1 < dt.NumVertices(); ++v) {
+      EXPECT_EQ(dt.StarVersion(VertexId(v)) != version[v], in_new[v] != 0) << v;
+      if (in_new[v]) continue;
+      const Reference now = ReferenceWalk(dt, VertexId(v));
+      EXPECT_EQ(now.star, before[v].star) << v;
+      EXPECT_EQ(now.neighbors, before[v].neighbors) << v;
+    }
+  }
+}
+
 // A 7^3 integer grid: every cube's corners are cospherical, SoS decides.
 TEST(Delaunay3QueriesTest, DegenerateGrid) {
   std::vector<Vec3> pts;
