@@ -1,11 +1,15 @@
 #include "core/api.h"
 
 #include <chrono>
+#include <cmath>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/delaunay/point_set.h"
 #include "core/geometry/predicates.h"
+#include "core/plc/validate.h"
+#include "core/svrc/assemble.h"
+#include "core/svrc/refiner.h"
 
 namespace svrc::core {
 namespace {
@@ -83,6 +87,96 @@ absl::StatusOr<mesh::TetMesh> MeshPointSet(const plc::Plc& plc, const ProgressCa
   return out;
 }
 
+// A PLC with segments or facets: SVRC refinement (core/svrc, thesis ch. 3),
+// then region labelling and assembly (docs/svrc-output.md).
+absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams& params,
+                                          const ProgressCallback& progress, const CancelToken* cancel) {
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  auto report = [&](const char* phase, uint64_t vertices, uint64_t queue, double radius) {
+    if (!progress) return;
+    Progress p;
+    p.phase = phase;
+    p.vertices = vertices;
+    p.queue_size = queue;
+    p.largest_work_radius = radius;
+    p.elapsed_seconds = elapsed();
+    progress(p);
+  };
+  if (!(params.radius_edge > 0) || !std::isfinite(params.radius_edge)) {
+    return absl::InvalidArgumentError("radius_edge must be a positive number");
+  }
+  if (!(params.theta > 0 && params.theta < 1)) return absl::InvalidArgumentError("theta must be in (0, 1)");
+  report("validate", 0, 0, 0);
+  plc::ValidationReport vreport;
+  absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(plc, {}, {}, &vreport);
+  if (!complex.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(plc.source_name.empty() ? "<memory>" : plc.source_name, ": ",
+                                                   complex.status().message()));
+  }
+  const double seconds_validate = elapsed();
+  refine::RefineOptions options;
+  options.tau = 2.0 * params.radius_edge;
+  options.theta = params.theta;
+  options.max_vertices = params.max_vertices;
+  if (cancel != nullptr || progress) {
+    options.poll = [&]() -> absl::Status {
+      if (cancel != nullptr) {
+        absl::Status s = cancel->Check();
+        if (!s.ok()) return s;
+      }
+      return absl::OkStatus();
+    };
+  }
+  options.progress = [&](uint64_t vertices, uint64_t queue, double radius) {
+    report("refine", vertices, queue, radius);
+  };
+  report("refine", 0, 0, 0);
+  absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
+  if (!refined.ok()) return refined.status();
+  const double seconds_refine = elapsed() - seconds_validate;
+  report("assemble", refined->stats.vertices, 0, 0);
+  std::vector<refine::ConstrainedFace> faces;
+  for (uint32_t f = 0; f < refined->facet_triangles.size(); ++f) {
+    for (const auto& t : refined->facet_triangles[f]) {
+      refine::ConstrainedFace cf;
+      cf.v = t;
+      cf.marker = complex->facets[f].marker;
+      cf.facet = complex->facets[f].input_facet;
+      faces.push_back(cf);
+    }
+  }
+  mesh::MeshStats stats;
+  refined->stats.ExportTo(&stats);
+  refine::CoordinateMap map;
+  // The refiner's exact normalisation, recovered from an input point: the map
+  // is x' = (x − t)·2^−e, identical on every axis scale.
+  map.translation = refined->normalisation_translation;
+  map.exponent = refined->normalisation_exponent;
+  absl::StatusOr<refine::OutputStageResult> out =
+      refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex, faces, map,
+                              params.keep_bounding_box, &stats);
+  if (!out.ok()) return out.status();
+  if (out->report.num_nonpositive_tets != 0) {
+    return absl::InternalError(absl::StrCat("SVRC: ", out->report.num_nonpositive_tets,
+                                            " tets inverted by mapping Steiner points back to input coordinates"));
+  }
+  mesh::TetMesh mesh = std::move(out->mesh);
+  mesh.provenance.svrc_version = Version();
+  mesh.provenance.parameters = absl::StrCat("mode=svrc radius_edge=", params.radius_edge, " theta=", params.theta,
+                                            " keep_bounding_box=", params.keep_bounding_box ? 1 : 0);
+  mesh.provenance.input_sha256 = plc.input_sha256;
+  mesh.stats.Set("tets", static_cast<double>(mesh.tets.size()));
+  mesh.stats.Set("output_vertices", static_cast<double>(mesh.positions.size()));
+  mesh.stats.Set("seconds_validate", seconds_validate);
+  mesh.stats.Set("seconds_refine", seconds_refine);
+  mesh.stats.Set("seconds_total", elapsed());
+  report("done", mesh.positions.size(), 0, 0);
+  return mesh;
+}
+
 }  // namespace
 
 absl::Status CancelToken::Check() const {
@@ -97,8 +191,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlc(const plc::Plc& plc, const MeshParams& par
                                       const ProgressCallback& progress,
                                       const CancelToken* cancel) {
   if (plc.IsPointSet()) return MeshPointSet(plc, progress, cancel);
-  return absl::UnimplementedError(
-      "PLC meshing (SVRC refinement) is not implemented yet; only point sets are supported");
+  return MeshPlcSvrc(plc, params, progress, cancel);
 }
 
 }  // namespace svrc::core

@@ -94,26 +94,27 @@ FacetRegion::Where FacetRegion::Locate(Vec2 p) const {
   return Where::kInside;
 }
 
-bool FacetRegion::CrossesSegment(Vec2 a, Vec2 b, Vec2 c) const {
+bool TriangleMeetsSegment(Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
   const std::array<Vec2, 3> t = {a, b, c};
+  // Triangle edge lines (abc counter-clockwise: interior is left, > 0).
+  for (int e = 0; e < 3; ++e) {
+    const Vec2 u = t[e], w = t[(e + 1) % 3];
+    if (geom::Orient2d(u, w, s0) <= 0 && geom::Orient2d(u, w, s1) <= 0) return false;
+  }
+  // The segment's line: the open triangle is on one side iff all three
+  // vertices are on one closed side (not all zero: abc is not degenerate).
+  int pos = 0, neg = 0;
+  for (const Vec2& x : t) {
+    const int o = geom::Orient2d(s0, s1, x);
+    pos += o > 0;
+    neg += o < 0;
+  }
+  return pos != 0 && neg != 0;
+}
+
+bool FacetRegion::CrossesSegment(Vec2 a, Vec2 b, Vec2 c) const {
   for (const auto& s : segments) {
-    bool separated = false;
-    // Triangle edge lines (abc counter-clockwise: interior is left, > 0).
-    for (int e = 0; e < 3 && !separated; ++e) {
-      const Vec2 u = t[e], w = t[(e + 1) % 3];
-      separated = geom::Orient2d(u, w, s[0]) <= 0 && geom::Orient2d(u, w, s[1]) <= 0;
-    }
-    if (separated) continue;
-    // The segment's line: the open triangle is on one side iff all three
-    // vertices are on one closed side (not all zero: abc is not degenerate).
-    int pos = 0, neg = 0;
-    for (const Vec2& x : t) {
-      const int o = geom::Orient2d(s[0], s[1], x);
-      pos += o > 0;
-      neg += o < 0;
-    }
-    if (pos == 0 || neg == 0) continue;
-    return true;
+    if (TriangleMeetsSegment(a, b, c, s[0], s[1])) return true;
   }
   return false;
 }
@@ -160,7 +161,7 @@ FacetMesh::FacetMesh(FacetRegion region, const std::array<PointId, 4>& corner_id
     : region_(std::move(region)),
       square_lo_(SquareOf(region_).first),
       square_hi_(SquareOf(region_).second),
-      dt_(Delaunay2::Square(square_lo_, square_hi_,
+      dt_(Delaunay2::Square(square_lo_ - (square_hi_ - square_lo_), square_hi_ + (square_hi_ - square_lo_),
                             {corner_ids[0].value(), corner_ids[1].value(), corner_ids[2].value(),
                              corner_ids[3].value()})) {
   for (uint32_t i = 0; i < 4; ++i) Register(Delaunay2::VertexId(i), corner_ids[i]);
@@ -218,12 +219,13 @@ void FacetMesh::TriangleBall(TriId2 t, const plc::FacetFrame& frame, geom::Vec3*
 
 void FacetMesh::SyncTriangleBalls(const Delaunay2::InsertResult& r, const plc::FacetFrame& frame,
                                   FeatureId feature, MeshId mesh, BallStore* balls,
-                                  std::vector<BallId>* added) {
+                                  std::vector<BallId>* added, std::vector<BallId>* killed) {
   if (r.outcome != Delaunay2::InsertOutcome::kInserted) return;
   // Destroyed first: slots are reused, so a slot can be in both lists.
   for (TriId2 t : r.destroyed) {
     if (t.value() < tri_ball_.size() && tri_ball_[t.value()].valid()) {
       balls->Kill(tri_ball_[t.value()]);
+      if (killed != nullptr) killed->push_back(tri_ball_[t.value()]);
       tri_ball_[t.value()] = kNoneBall;
     }
   }

@@ -66,6 +66,11 @@ struct FacetRegion {
   geom::Vec2 lo{0, 0}, hi{0, 0};
 };
 
+// True iff the closed segment s0s1 meets the open counter-clockwise triangle
+// abc (exact: one of the triangle's edge lines or the segment's line
+// separates them, the separating-axis theorem in 2D).
+bool TriangleMeetsSegment(geom::Vec2 a, geom::Vec2 b, geom::Vec2 c, geom::Vec2 s0, geom::Vec2 s1);
+
 // Builds F's region in the *normalised* frame: the frame's origin goes through
 // the same exact map as the points (its u, v are unchanged: the map is a
 // translation and a power-of-two scale), and every point of F is projected
@@ -101,6 +106,13 @@ class FacetMesh {
   geom::Vec2 SquareHi() const { return square_hi_; }
   // Corner i of Ω_F in the order of the constructor.
   geom::Vec2 Corner(int i) const;
+  // Vertex i < 4 of M_F: a corner of the Delaunay quadrilateral, the square
+  // of 3× Ω_F's side around it. Ω_F's cells are clipped to Ω_F, whose sides
+  // are then strictly inside the triangulated square, so the clipped cell
+  // corners on ∂Ω_F can be inserted like any Voronoi corner (as ∂Ω's in
+  // M_Ω; docs/svrc-design.md §10). The 4 vertices' cells meet Ω_F in a
+  // corner region only, shrinking to nothing as ∂Ω_F is sampled.
+  geom::Vec2 QuadCorner(int i) const { return dt_.Point(VertexId2(static_cast<uint32_t>(i))); }
 
   // Inserts p (uv, strictly inside Ω_F) as global point `id`; registers the
   // vertex and bumps the cells of the cavity boundary (Figure 3.5's 𝒱').
@@ -133,9 +145,11 @@ class FacetMesh {
   // (in-facet status is fixed per triangle: it depends only on its vertices).
   // `added` (optional) receives the new balls, for linking into M_Ω. Call once
   // per Insert, with its result, before the next Insert.
+  // `killed` (optional) receives the balls it killed, for unlinking.
   void SyncTriangleBalls(const Delaunay2::InsertResult& r, const plc::FacetFrame& frame,
                          FeatureId feature, MeshId mesh, BallStore* balls,
-                         std::vector<BallId>* added = nullptr);
+                         std::vector<BallId>* added = nullptr,
+                         std::vector<BallId>* killed = nullptr);
   // All live in-facet triangles get balls (after the initial inserts).
   void CreateAllTriangleBalls(const plc::FacetFrame& frame, FeatureId feature, MeshId mesh,
                               BallStore* balls, std::vector<BallId>* added = nullptr);

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <optional>
 #include <tuple>
@@ -14,6 +16,7 @@
 #include "core/plc/features.h"
 #include "core/svrc/balls.h"
 #include "core/svrc/containment.h"
+#include "core/svrc/facet_mesh.h"
 #include "core/svrc/feature_meshes.h"
 #include "core/svrc/location_graph.h"
 #include "core/svrc/normalize.h"
@@ -23,7 +26,30 @@
 namespace svrc::refine {
 namespace {
 
+using geom::Vec2;
 using geom::Vec3;
+using VertexId2 = FacetMesh::VertexId2;
+using TriId2 = FacetMesh::TriId2;
+
+// "Deeply inside" a protective ball: inside by more than the rounding noise
+// of constructed points (docs/svrc-design.md §8 item 12). Facet Steiner
+// points are rounded off their plane and frames are not exact, so exact ties
+// of the construction (a circumcentre on a piece's diametral sphere at a 90°
+// edge) come out strictly inside or outside at random; counting those as
+// encroachment (or as a reason to yield) refines without end in self-similar
+// corners (measured on cube.poly: to 3·10^−5 and the vertex budget).
+// Encroachment and yields therefore need the exact predicate AND this margin;
+// whatever the margin lets through is caught exactly at the end: a piece or
+// triangle that is not a simplex of its meshes is enqueued (EnqueueMissing).
+bool DeepInside(const Vec3& c, double r, const Vec3& x) {
+  return geom::Dist2(x, c) < r * r * (1 - 1e-9) - 1e-13 * r;
+}
+bool DeepInside2(Vec2 c, double r, Vec2 x) {
+  const double dx = x.x - c.x, dy = x.y - c.y;
+  return dx * dx + dy * dy < r * r * (1 - 1e-9) - 1e-13 * r;
+}
+Vec2 Mid2(Vec2 a, Vec2 b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}; }
+double HalfLen2(Vec2 a, Vec2 b) { return 0.5 * std::hypot(a.x - b.x, a.y - b.y); }
 
 class Refiner {
  public:
@@ -31,9 +57,24 @@ class Refiner {
       : options_(options), norm_(norm), omega_(center, half) {}
 
   absl::Status Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments);
+  // Shared by both entry points: the complex's points are `normalised` (global
+  // ids 0..n−1), its segments and facets become meshes (Figure 3.3).
+  absl::Status Setup(const plc::FeatureComplex& complex, std::span<const Vec3> normalised);
   absl::Status Run();
   absl::Status CheckInvariants(bool final);
   PointSetRefinement Output(std::span<const Vec3> input);
+  // The facts the output stage relies on, checked on the final meshes: every
+  // segment piece is an edge and every in-facet triangle a face of M_Ω, all
+  // their vertices in M_Ω. INTERNAL naming the first failure.
+  absl::Status VerifyConformity() const;
+  // The sorted point-id faces and edges of M_Ω's finite tets.
+  void OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces, std::vector<std::array<uint32_t, 2>>* edges) const;
+  // End of the queues: a piece that is not an edge of M_Ω or of a facet mesh
+  // containing it, or an in-facet triangle that is not a face of M_Ω, has a
+  // non-encroached but tied ball (vertices exactly on its sphere on several
+  // sides, decided by the perturbation against it): enqueue it Encroached.
+  // Returns whether anything was enqueued.
+  bool EnqueueMissing();
 
  private:
   // --- Destroy (Figure 3.4) -------------------------------------------------
@@ -44,10 +85,20 @@ class Refiner {
   // A gap ball of segment mesh `seg` whose centre is the midpoint of the piece
   // starting at local vertex u (Encroached₁ of the piece ball, Skinny₁).
   absl::Status DestroySegmentPiece(uint32_t seg, uint32_t u);
+  // A gap ball ⟨(c, r), F⟩ of facet mesh f (uv coordinates): Skinny₂ /
+  // Unresolved₂ of a cell, or a triangle's circumdisk (Encroached₂, or a
+  // yield from M_Ω). `hint`: a triangle of M_F in conflict with c.
+  // `tri`: the triangle whose ball is being destroyed (kNone for a cell's
+  // gap ball); a piece of F crossing it is yielded to.
+  absl::Status DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, TriId2 tri = TriId2());
+  // Destroys a conforming ball of a lower feature (a yield target or an
+  // Encroached event): a segment piece or a facet triangle.
+  absl::Status DestroyBall(BallId b);
 
   // --- ForceInsert (Figure 3.5) + UpdateLocation (3.6) + PropagateLocation (3.9)
   absl::Status ForceInsertOmega(PointId p, TetId hint);
   absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t);
+  absl::Status ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hint);
 
   // --- BLG helpers -------------------------------------------------------------
   // Cells of M_Ω that may meet B(c, r), given a vertex w nearest to c: BFS over
@@ -61,18 +112,49 @@ class Refiner {
   // point (an unresolved object), refresh that cell's events.
   void LinkVertexBallToOmega(BallId b, VertexId start);
   // AddLink(x, Ω, B) for a piece ball with Figure 3.10's encroachment trap.
-  void AddPieceLink(VertexId x, BallId b);
+  void AddBallLink(VertexId x, BallId b);
   bool Encroaches(BallId b, VertexId x) const;
+  // x strictly (exact) and deeply (margin) inside ball b in 3D.
+  bool Inside(BallId b, const Vec3& x) const;
   void EnqueueEncroached(BallId b);
+  // The balls of the (new) in-facet triangles `tris` of facet f: remember
+  // each ball's triangle, link it into M_Ω (PropagateLocation, Figure 3.9).
+  void AdoptTriangleBalls(uint32_t f, std::span<const TriId2> tris, VertexId start);
+
+  // --- facet meshes (stage (c)) ----------------------------------------------
+  // Cells of M_F that may meet the disk B(c, r) (same bisector bound as 3D).
+  void CellsMeetingDisk(uint32_t f, Vec2 c, double r, VertexId2 w, std::vector<VertexId2>* out);
+  // PropagateLocation of a segment piece ball into M_F (a facet containing
+  // the segment) and of a 0-ball of a point of F (unresolved in M_F).
+  void LinkPieceToFacet(BallId b, uint32_t f, TriId2 hint);
+  void LinkVertexBallToFacet(BallId b, uint32_t f, TriId2 hint);
+  // AddLink(x, F, piece ball) with Figure 3.10's trap, decided in uv.
+  void AddFacetPieceLink(uint32_t f, VertexId2 x, BallId b);
+  bool EncroachesInFacet(uint32_t f, BallId b, VertexId2 x) const;
+  // The point's coordinates in F's frame: its M_F vertex if it has one, else
+  // its xyz projected (a pure function of xyz, so the same value every time;
+  // design §2 "rounded once").
+  Vec2 Uv(uint32_t f, PointId p) const;
+  // Does point p (a vertex of the mesh the ball lives in) encroach ball b in
+  // some mesh it was linked in? (End-of-run partial encroachment check.)
+  bool EncroachedByPoint(BallId b, PointId p) const;
 
   // --- Events -----------------------------------------------------------------
   void RefreshEvents(VertexId v, const CellSize* size = nullptr);
   void RefreshSegmentEvents(uint32_t seg, uint32_t v);
+  void RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size = nullptr);
   bool IsLive(const WorkEvent& event);
   bool IsSkinny(const CellSize& s) const { return s.outradius > options_.tau * s.inradius; }
   bool IsSkinny(const SegmentMesh::Size1& s) const { return s.outradius > options_.tau * s.inradius; }
+  bool IsSkinny(const CellSize2& s) const { return s.outradius > options_.tau * s.inradius; }
 
   bool IsOmega(MeshId m) const { return m == kOmegaMesh; }
+  bool IsSegMesh(MeshId m) const { return !segs_.empty() && m.value() >= seg_mesh0_ && m.value() < seg_mesh0_ + segs_.size(); }
+  bool IsFacetMesh(MeshId m) const {
+    return !facets_.empty() && m.value() >= facet_mesh0_ && m.value() < facet_mesh0_ + facets_.size();
+  }
+  uint32_t FacetIndex(MeshId m) const { return m.value() - facet_mesh0_; }
+  MeshId FacetMeshId(uint32_t f) const { return MeshId(facet_mesh0_ + f); }
   uint32_t SegIndex(MeshId m) const { return m.value() - seg_mesh0_; }
   MeshId SegMesh(uint32_t seg) const { return MeshId(seg_mesh0_ + seg); }
   BallId VertexBallOf(PointId p) const {
@@ -82,7 +164,9 @@ class Refiner {
     if (vertex_ball_.size() <= p.value()) vertex_ball_.resize(p.value() + 1, kNoneBall);
     vertex_ball_[p.value()] = b;
   }
-  uint64_t TotalVertices() const { return omega_.dt().NumVertices() + stats_.segment_vertices; }
+  uint64_t TotalVertices() const {
+    return omega_.dt().NumVertices() + stats_.segment_vertices + stats_.facet_vertices;
+  }
 
   RefineOptions options_;
   Normalization norm_;
@@ -100,6 +184,22 @@ class Refiner {
   std::vector<BallId> vertex_ball_;     // per global point: its 0-ball (kNoneBall: none)
   std::vector<uint32_t> piece_vertex_;  // per ball: local vertex starting its piece
   std::vector<uint32_t> piece_seg_;     // per ball: its segment
+  // Facets (stage (c)).
+  std::vector<FacetMesh> facets_;
+  std::vector<plc::FacetFrame> frames_;  // normalised frames
+  uint32_t facet_mesh0_ = 0;             // MeshId of facet 0 (= its FeatureId)
+  std::vector<std::vector<uint32_t>> point_facets_;  // per complex point: facets containing it
+  std::vector<std::vector<uint32_t>> seg_facets_;    // per segment: facets containing it
+  std::vector<uint32_t> tri_of_ball_;    // per triangle ball: its M_F triangle slot
+  std::vector<uint32_t> facet_input_;    // per facet: index in Plc::facets
+  std::vector<int32_t> facet_marker_;
+  CellSize2 last_size2_;
+  uint32_t last_size2_facet_ = 0xFFFFFFFFu;
+  VertexId2 last_size2_vertex_;
+  uint32_t last_size2_gen_ = 0;
+  std::vector<VertexId2> bfs2_, nbrs2_;
+  std::vector<uint32_t> mark2_;
+  uint32_t stamp2_ = 0;
   // Balls that got a first, non-native encroacher (PartiallyEncroached).
   std::vector<BallId> partial_;
   RefineStats stats_;
@@ -177,8 +277,18 @@ absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<con
       }
     }
   }
+  return Setup(complex, normalised);
+}
+
+absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const Vec3> normalised) {
+  num_input_ = static_cast<uint32_t>(normalised.size());
+  if (duplicate_of_.size() != num_input_) {
+    duplicate_of_.resize(num_input_);
+    for (uint32_t i = 0; i < num_input_; ++i) duplicate_of_[i] = i;
+  }
   features_ = FeatureTable::Build(complex);
-  seg_mesh0_ = segments.empty() ? 0 : features_.OfSegment(0).value();
+  seg_mesh0_ = complex.segments.empty() ? 0 : features_.OfSegment(0).value();
+  facet_mesh0_ = complex.facets.empty() ? 0 : features_.OfFacet(0).value();
   budget_ = options_.max_vertices != 0 ? options_.max_vertices
                                        : std::max<uint64_t>(1'000'000, 1000ull * num_input_);
   // Global ids = SoS priorities: inputs first (in input order), then corners.
@@ -190,10 +300,37 @@ absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<con
   omega_.SeedCorners(corners);
   for (int i = 0; i < 8; ++i) points_.SetVertex(corners[i], kOmegaMesh, i);
 
+  // Facet meshes (Definition 35): M_F in F's normalised frame inside the
+  // square Ω_F, seeded with its 4 corners (global points of CD (2,3) that are
+  // never in F, so they get no 0-ball and never reach M_Ω).
+  point_facets_.assign(num_input_, {});
+  seg_facets_.assign(complex.segments.size(), {});
+  for (uint32_t s = 0; s < complex.segments.size(); ++s) seg_facets_[s] = complex.segments[s].facets;
+  std::vector<PointId> ids(num_input_);
+  for (uint32_t i = 0; i < num_input_; ++i) ids[i] = PointId(i);
+  facets_.reserve(complex.facets.size());
+  for (uint32_t f = 0; f < complex.facets.size(); ++f) {
+    plc::FacetFrame frame;
+    FacetRegion region = BuildFacetRegion(complex, f, norm_, ids, &frame);
+    const uint32_t next = points_.size();
+    const std::array<PointId, 4> cids{PointId(next), PointId(next + 1), PointId(next + 2), PointId(next + 3)};
+    facets_.emplace_back(std::move(region), cids);
+    frames_.push_back(frame);
+    facet_input_.push_back(complex.facets[f].input_facet);
+    facet_marker_.push_back(complex.facets[f].marker);
+    for (int i = 0; i < 4; ++i) {
+      const PointId c = points_.Add(frame.ToSpace(facets_.back().QuadCorner(i)), features_.OfFacet(f), kCdFacet);
+      points_.SetVertex(c, FacetMeshId(f), i);
+    }
+    for (PointId p : facets_.back().region().all_points) {
+      if (p.value() < num_input_) point_facets_[p.value()].push_back(f);
+    }
+  }
+
   // Figure 3.3: UpdateLocation(∅, M_F, F) for every feature, lowest dimension
   // first. A point feature's mesh is {p}: one 0-ball, propagated to its
   // superfeatures. It is a vertex of its segments' meshes from the start
-  // (their seeds), so only M_Ω has it unresolved.
+  // (their seeds), so only M_Ω and the facet meshes have it unresolved.
   for (uint32_t i = 0; i < num_input_; ++i) {
     if (duplicate_of_[i] != i) {
       ++stats_.duplicates;
@@ -202,11 +339,13 @@ absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<con
     const FeatureId f = features_.OfPoint(i);
     const BallId b = balls_.AddVertexBall(PointId(i), normalised[i], f, MeshId(f.value()), kCdInputVertex);
     SetVertexBall(PointId(i), b);
+    for (uint32_t fc : point_facets_[i]) LinkVertexBallToFacet(b, fc, TriId2());
     LinkVertexBallToOmega(b, VertexId(0));
   }
   // Segment meshes, seeded with their endpoints (Ω_s = s); their pieces'
-  // diametral ConfBalls go to M_Ω. The endpoints' 0-balls are the point
-  // features' (one ball per global point; guide §7).
+  // diametral ConfBalls go to the facets containing them and to M_Ω. The
+  // endpoints' 0-balls are the point features' (one ball per global point;
+  // guide §7).
   for (uint32_t s = 0; s < complex.segments.size(); ++s) {
     const PointId a(complex.segments[s].a), b(complex.segments[s].b);
     segs_.emplace_back(a, b, points_.Xyz(a), points_.Xyz(b));
@@ -224,11 +363,22 @@ absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<con
     }
     piece_vertex_[piece.value()] = 0;
     piece_seg_[piece.value()] = s;
+    for (uint32_t fc : seg_facets_[s]) LinkPieceToFacet(piece, fc, TriId2());
     LinkBallToOmega(piece, VertexId(0));
+  }
+  // The seed triangles of each M_F that are in F (they contain it) get
+  // triangle ConfBalls, linked into M_Ω.
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    facets_[f].CreateAllTriangleBalls(frames_[f], features_.OfFacet(f), FacetMeshId(f), &balls_);
+    const std::vector<TriId2> tris = facets_[f].dt().Triangles();
+    AdoptTriangleBalls(f, tris, VertexId(0));
   }
   for (uint32_t v = 0; v < omega_.NumVertices(); ++v) RefreshEvents(VertexId(v));
   for (uint32_t s = 0; s < segs_.size(); ++s) {
     for (uint32_t v = 0; v < segs_[s].NumVertices(); ++v) RefreshSegmentEvents(s, v);
+  }
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    for (uint32_t v = 0; v < facets_[f].NumVertices(); ++v) RefreshFacetEvents(f, VertexId2(v));
   }
   return absl::OkStatus();
 }
@@ -267,10 +417,120 @@ bool Refiner::Encroaches(BallId b, VertexId x) const {
   // witness for ab is decided by the perturbation, which need not favour ab
   // (docs/svrc-design.md §2, §8). The piece's own endpoints are on the sphere
   // by definition and do not count.
+  // A triangle ball likewise: the closed diametral ball of abc
+  // (InTriangleCircumball3d ≥ 0 on the rounded xyz, design §2), its own
+  // vertices excluded.
   const PointId p = omega_.PointOf(x);
-  if (p == balls_.Vertex(b, 0) || p == balls_.Vertex(b, 1)) return false;
-  return geom::InDiametralSphere(points_.Xyz(balls_.Vertex(b, 0)), points_.Xyz(balls_.Vertex(b, 1)),
-                                 omega_.dt().Point(x)) >= 0;
+  const int n = balls_.NumVertices(b);
+  for (int i = 0; i < n; ++i) {
+    if (p == balls_.Vertex(b, i)) return false;
+  }
+  return Inside(b, omega_.dt().Point(x));
+}
+
+bool Refiner::Inside(BallId b, const Vec3& px) const {
+  if (!DeepInside(balls_.Center(b), balls_.Radius(b), px)) return false;
+  if (balls_.NumVertices(b) == 2) {
+    return geom::InDiametralSphere(points_.Xyz(balls_.Vertex(b, 0)), points_.Xyz(balls_.Vertex(b, 1)), px) > 0;
+  }
+  return geom::InTriangleCircumball3d(points_.Xyz(balls_.Vertex(b, 0)), points_.Xyz(balls_.Vertex(b, 1)),
+                                      points_.Xyz(balls_.Vertex(b, 2)), px) > 0;
+}
+
+Vec2 Refiner::Uv(uint32_t f, PointId p) const {
+  const uint32_t v = points_.VertexIn(p, FacetMeshId(f));
+  if (v != PointStore::kNoVertex) return facets_[f].dt().Point(VertexId2(v));
+  return frames_[f].ToPlane(points_.Xyz(p));
+}
+
+bool Refiner::EncroachesInFacet(uint32_t f, BallId b, VertexId2 x) const {
+  // A piece ab of a segment of F in M_F: x in the closed diametral disk of
+  // ab in uv (§8 item 9), endpoints excluded.
+  const FacetMesh& m = facets_[f];
+  const PointId p = m.PointOf(x);
+  const PointId a = balls_.Vertex(b, 0), c = balls_.Vertex(b, 1);
+  if (p == a || p == c) return false;
+  const Vec2 ua = Uv(f, a), uc = Uv(f, c), ux = m.dt().Point(x);
+  return DeepInside2(Mid2(ua, uc), HalfLen2(ua, uc), ux) && geom::InDiametralCircle(ua, uc, ux) > 0;
+}
+
+bool Refiner::EncroachedByPoint(BallId b, PointId p) const {
+  const uint32_t x = points_.VertexIn(p, kOmegaMesh);
+  if (x != PointStore::kNoVertex && Encroaches(b, VertexId(x))) return true;
+  if (balls_.NumVertices(b) == 2 && !facets_.empty()) {
+    for (uint32_t f : seg_facets_[piece_seg_[b.value()]]) {
+      const uint32_t y = points_.VertexIn(p, FacetMeshId(f));
+      if (y != PointStore::kNoVertex && EncroachesInFacet(f, b, VertexId2(y))) return true;
+    }
+  }
+  return false;
+}
+
+void Refiner::CellsMeetingDisk(uint32_t f, Vec2 c, double r, VertexId2 w, std::vector<VertexId2>* out) {
+  // The 2D twin of CellsMeetingBall (same bisector bound).
+  const delaunay::Delaunay2& dt = facets_[f].dt();
+  const Vec2 pw = dt.Point(w);
+  auto d2 = [](Vec2 a, Vec2 b) { return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y); };
+  const double wc2 = d2(pw, c);
+  auto may_meet = [&](Vec2 px) {
+    return d2(px, c) - wc2 <= 2.0 * r * std::sqrt(d2(px, pw)) * (1 + 1e-9) + 1e-12 * wc2;
+  };
+  ++stamp2_;
+  if (mark2_.size() < dt.NumVertices()) mark2_.resize(dt.NumVertices() + 64, 0);
+  out->clear();
+  out->push_back(w);
+  mark2_[w.value()] = stamp2_;
+  for (size_t i = 0; i < out->size(); ++i) {
+    dt.Neighbors((*out)[i], &nbrs2_);
+    for (VertexId2 x : nbrs2_) {
+      if (mark2_[x.value()] == stamp2_) continue;
+      mark2_[x.value()] = stamp2_;
+      if (may_meet(dt.Point(x))) out->push_back(x);
+    }
+  }
+}
+
+void Refiner::AddFacetPieceLink(uint32_t f, VertexId2 x, BallId b) {
+  LinkFacts facts;
+  facts.encroaches = EncroachesInFacet(f, b, x);
+  const PointId p = facets_[f].PointOf(x);
+  facts.native = points_.CdOf(p).dim == 2;  // created in a facet mesh (this one: it is its vertex)
+  facts.vertex_point = p;
+  const AddLinkResult r = blg_.AddLink(FacetMeshId(f), x.value(), LocationObject::Ball(b), facts, &balls_);
+  if (r.encroach == EncroachOutcome::kEnqueue) EnqueueEncroached(b);
+  if (r.encroach == EncroachOutcome::kPartial) partial_.push_back(b);
+}
+
+void Refiner::LinkPieceToFacet(BallId b, uint32_t f, TriId2 hint) {
+  const delaunay::Delaunay2& dt = facets_[f].dt();
+  const Vec2 a = Uv(f, balls_.Vertex(b, 0)), c = Uv(f, balls_.Vertex(b, 1));
+  const Vec2 mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
+  const double r = 0.5 * std::sqrt((a.x - c.x) * (a.x - c.x) + (a.y - c.y) * (a.y - c.y));
+  const VertexId2 w = dt.NearestVertex(mid, hint);
+  std::vector<VertexId2> cells;
+  CellsMeetingDisk(f, mid, r, w, &cells);
+  for (VertexId2 x : cells) AddFacetPieceLink(f, x, b);
+}
+
+void Refiner::LinkVertexBallToFacet(BallId b, uint32_t f, TriId2 hint) {
+  const delaunay::Delaunay2& dt = facets_[f].dt();
+  const VertexId2 cell = dt.NearestVertex(Uv(f, balls_.VertexPoint(b)), hint);
+  LinkFacts facts;
+  facts.unresolved = true;
+  const AddLinkResult r = blg_.AddLink(FacetMeshId(f), cell.value(), LocationObject::Ball(b), facts, &balls_);
+  if (r.cell_became_unresolved) RefreshFacetEvents(f, cell);
+}
+
+void Refiner::AdoptTriangleBalls(uint32_t f, std::span<const TriId2> tris, VertexId start) {
+  const FacetMesh& m = facets_[f];
+  if (tri_of_ball_.size() < balls_.size()) tri_of_ball_.resize(balls_.size() + 64, 0xFFFFFFFFu);
+  for (TriId2 t : tris) {
+    if (!m.dt().IsAlive(t)) continue;
+    const BallId b = m.TriBall(t);
+    if (!b.valid() || !balls_.IsAlive(b) || tri_of_ball_[b.value()] == t.value()) continue;
+    tri_of_ball_[b.value()] = t.value();
+    LinkBallToOmega(b, start);
+  }
 }
 
 void Refiner::EnqueueEncroached(BallId b) {
@@ -281,13 +541,18 @@ void Refiner::EnqueueEncroached(BallId b) {
   if (queues_.Enqueue(e).valid()) balls_.SetEncroachQueued(b, true);
 }
 
-void Refiner::AddPieceLink(VertexId x, BallId b) {
+void Refiner::AddBallLink(VertexId x, BallId b) {
   LinkFacts facts;
   facts.encroaches = Encroaches(b, x);
   const PointId p = omega_.PointOf(x);
   facts.native = points_.CdOf(p).dim == 3;  // CD(x) = dim Ω: created in M_Ω
   facts.vertex_point = p;
   const AddLinkResult r = blg_.AddLink(kOmegaMesh, x.value(), LocationObject::Ball(b), facts, &balls_);
+  if (getenv("SVRC_DEBUG2") && r.encroach == EncroachOutcome::kEnqueue && balls_.Radius(b) < atof(getenv("SVRC_DEBUG2"))) {
+    const Vec3& q = points_.Xyz(p);
+    fprintf(stderr, "ENC ball %u (nv=%d r=%g c=%g %g %g) by point %u cd=%d parent=%u xyz=(%g %g %g) native=%d\n", b.value(), balls_.NumVertices(b),
+            balls_.Radius(b), balls_.Center(b).x, balls_.Center(b).y, balls_.Center(b).z, p.value(), points_.CdOf(p).dim, points_.Parent(p).value(), q.x, q.y, q.z, (int)facts.native);
+  }
   if (r.encroach == EncroachOutcome::kEnqueue) EnqueueEncroached(b);
   if (r.encroach == EncroachOutcome::kPartial) partial_.push_back(b);
 }
@@ -297,7 +562,7 @@ void Refiner::LinkBallToOmega(BallId b, VertexId start) {
   const VertexId w = dt.NearestVertex(balls_.Center(b), dt.VertexTet(start));
   std::vector<VertexId> cells;
   CellsMeetingBall(balls_.Center(b), balls_.Radius(b), w, &cells);
-  for (VertexId x : cells) AddPieceLink(x, b);
+  for (VertexId x : cells) AddBallLink(x, b);
 }
 
 void Refiner::LinkVertexBallToOmega(BallId b, VertexId start) {
@@ -327,6 +592,9 @@ void Refiner::RefreshEvents(VertexId v, const CellSize* size) {
     queues_.Remove(u);
   }
   // Skinny: R_v/r_v > τ (Figure 3.5), gap ball at the farthest corner.
+  if (getenv("SVRC_WATCH") && v.value() == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
+    fprintf(stderr, "WATCH refresh v=%u gen=%u R=%g r=%g skinny=%d given=%d\n", v.value(), gen, s.outradius, s.inradius, (int)IsSkinny(s), size != nullptr);
+  }
   EventHandle& k = omega_.SkinnyEvent(v);
   if (IsSkinny(s)) {
     if (queues_.IsQueued(k)) {
@@ -356,11 +624,52 @@ void Refiner::RefreshSegmentEvents(uint32_t seg, uint32_t v) {
   }
 }
 
+void Refiner::RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size) {
+  FacetMesh& m = facets_[f];
+  const CellSize2 s = size != nullptr ? *size : m.Size(v);
+  const uint32_t gen = m.CellGeneration(v);
+  const MeshId mesh = FacetMeshId(f);
+  const Vec3 corner = frames_[f].ToSpace(s.corner);  // informational: rebuilt at pop
+  EventHandle& u = m.UnresolvedEvent(v);
+  if (blg_.NumUnresolved(mesh, v.value()) > 0) {
+    if (queues_.IsQueued(u)) {
+      queues_.Refresh(u, gen, corner, s.outradius);
+    } else {
+      u = queues_.Enqueue({EventType::kUnresolved, 2, mesh, v.value(), gen, s.outradius, corner});
+    }
+  } else if (queues_.IsQueued(u)) {
+    queues_.Remove(u);
+  }
+  EventHandle& k = m.SkinnyEvent(v);
+  if (IsSkinny(s)) {
+    if (queues_.IsQueued(k)) {
+      queues_.Refresh(k, gen, corner, s.outradius);
+    } else {
+      k = queues_.Enqueue({EventType::kSkinny, 2, mesh, v.value(), gen, s.outradius, corner});
+    }
+  } else if (queues_.IsQueued(k)) {
+    queues_.Remove(k);
+  }
+}
+
 bool Refiner::IsLive(const WorkEvent& e) {
   if (e.type == EventType::kEncroached) {
     const BallId b(e.object);
     balls_.SetEncroachQueued(b, false);
     return balls_.IsAlive(b) && balls_.Generation(b) == e.generation;
+  }
+  if (IsFacetMesh(e.mesh)) {
+    const uint32_t f = FacetIndex(e.mesh);
+    FacetMesh& m = facets_[f];
+    const VertexId2 v(e.object);
+    if (m.CellGeneration(v) != e.generation) return false;
+    if (e.type == EventType::kUnresolved && blg_.NumUnresolved(e.mesh, v.value()) == 0) return false;
+    last_size2_ = m.Size(v);
+    last_size2_facet_ = f;
+    last_size2_vertex_ = v;
+    last_size2_gen_ = m.CellGeneration(v);
+    if (e.type == EventType::kSkinny) return IsSkinny(last_size2_);
+    return true;
   }
   if (!IsOmega(e.mesh)) {
     SegmentMesh& m = segs_[SegIndex(e.mesh)];
@@ -387,12 +696,32 @@ absl::Status Refiner::Run() {
       return absl::ResourceExhaustedError(absl::StrCat(
           "SVRC: vertex budget of ", budget_, " reached with ", queues_.size(), " events pending"));
     }
-    if (options_.poll && destroys % options_.poll_interval == 0) {
-      absl::Status s = options_.poll();
-      if (!s.ok()) return s;
+    if (destroys % options_.poll_interval == 0) {
+      if (options_.poll) {
+        absl::Status s = options_.poll();
+        if (!s.ok()) return s;
+      }
+      if (options_.progress) options_.progress(TotalVertices(), queues_.size(), event->radius);
+      if (getenv("SVRC_DEBUG")) {
+        const WorkQueues::Stats& q = queues_.stats();
+        fprintf(stderr, "DBG omega=%u seg=%lu facet=%lu warps=%lu yields=%lu pushed s/e/u=%lu/%lu/%lu ev type=%d dim=%d mesh=%u\n",
+                omega_.NumVertices(), (unsigned long)stats_.segment_vertices, (unsigned long)stats_.facet_vertices,
+                (unsigned long)stats_.warps, (unsigned long)stats_.yields, (unsigned long)q.pushed[0],
+                (unsigned long)q.pushed[1], (unsigned long)q.pushed[2], (int)event->type, (int)event->dim, event->mesh.value());
+      }
     }
     ++destroys;
+    if (getenv("SVRC_DEBUG") && event->radius < atof(getenv("SVRC_DEBUG"))) {
+      fprintf(stderr, "SMALL ev type=%d dim=%d mesh=%u obj=%u r=%g c=(%g %g %g) omega=%u\n", (int)event->type, (int)event->dim,
+              event->mesh.value(), event->object, event->radius, event->center.x, event->center.y, event->center.z, omega_.NumVertices());
+    }
+    if (getenv("SVRC_WATCH") && event->mesh == kOmegaMesh && event->object == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
+      fprintf(stderr, "WATCH destroy type=%d gen=%u r=%g ins=%lu\n", (int)event->type, event->generation, event->radius, (unsigned long)stats_.insertions);
+    }
     absl::Status s = Destroy(*event);
+    if (getenv("SVRC_WATCH") && event->mesh == kOmegaMesh && event->object == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
+      fprintf(stderr, "WATCH after gen=%u ins=%lu\n", omega_.CellGeneration(VertexId(event->object)), (unsigned long)stats_.insertions);
+    }
     if (!s.ok()) return s;
     if (options_.validate_every > 0 && destroys % options_.validate_every == 0) {
       s = CheckInvariants(false);
@@ -409,12 +738,12 @@ absl::Status Refiner::Run() {
   bool more = false;
   for (BallId b : partial) {
     if (!balls_.IsAlive(b)) continue;
-    const uint32_t x = points_.VertexIn(balls_.FirstEncroacher(b), kOmegaMesh);
-    if (x != PointStore::kNoVertex && Encroaches(b, VertexId(x))) {
+    if (EncroachedByPoint(b, balls_.FirstEncroacher(b))) {
       EnqueueEncroached(b);
       more = true;
     }
   }
+  if (!more) more = EnqueueMissing();
   if (!more) break;
   }
   const geom::PredicateStats& pred = geom::GetPredicateStats();
@@ -428,15 +757,133 @@ absl::Status Refiner::Run() {
 // ---------------------------------------------------------------- Destroy
 
 absl::Status Refiner::Destroy(const WorkEvent& event) {
-  if (event.type == EventType::kEncroached) {
-    const BallId b(event.object);
-    return DestroySegmentPiece(piece_seg_[b.value()], piece_vertex_[b.value()]);
+  if (event.type == EventType::kEncroached) return DestroyBall(BallId(event.object));
+  if (IsFacetMesh(event.mesh)) {
+    const uint32_t f = FacetIndex(event.mesh);
+    const VertexId2 v(event.object);
+    const CellSize2 s = (last_size2_facet_ == f && last_size2_vertex_ == v &&
+                         last_size2_gen_ == facets_[f].CellGeneration(v))
+                            ? last_size2_
+                            : facets_[f].Size(v);
+    return DestroyFacet(f, s.corner, s.outradius, s.hint);
   }
   if (!IsOmega(event.mesh)) {
     const uint32_t seg = SegIndex(event.mesh);
     return DestroySegmentPiece(seg, segs_[seg].Size(event.object).piece);
   }
   return DestroyOmega(VertexId(event.object));
+}
+
+absl::Status Refiner::DestroyBall(BallId b) {
+  if (balls_.NumVertices(b) == 2) return DestroySegmentPiece(piece_seg_[b.value()], piece_vertex_[b.value()]);
+  // A triangle of M_F: its circumdisk is a gap ball of M_F (the triangle is
+  // Delaunay), centred at a Voronoi vertex; the triangle itself conflicts.
+  const uint32_t f = FacetIndex(balls_.Mesh(b));
+  const TriId2 t(tri_of_ball_[b.value()]);
+  const FacetMesh& m = facets_[f];
+  const delaunay::Delaunay2& dt = m.dt();
+  Vec2 c = dt.Circumcenter(t);
+  double r = dt.Circumradius(t);
+  // A triangle reaching the quadrilateral's corners can have its circumcentre
+  // outside Ω_F. Its disk meets F (the triangle does), hence Ω_F's interior,
+  // so the nearest point of Ω_F to c is strictly inside the disk: the gap
+  // ball B(clamp(c), r − |c − clamp(c)|) ⊂ the disk is empty and inserting its
+  // centre destroys t — the clipped-Voronoi reading of Definition 11.
+  const Vec2 cc{std::clamp(c.x, m.SquareLo().x, m.SquareHi().x), std::clamp(c.y, m.SquareLo().y, m.SquareHi().y)};
+  if (cc.x != c.x || cc.y != c.y) {
+    r -= std::hypot(c.x - cc.x, c.y - cc.y);
+    c = cc;
+  }
+  return DestroyFacet(f, c, r, t, t);
+}
+
+absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, TriId2 tri) {
+  // Figure 3.4 in M_F. 𝒱: cells meeting B (from the nearest vertex to c);
+  // 𝓑: balls linked to them — 0-balls of F's points and segment points
+  // (warp targets, CD < (2,3)) and piece balls of F's segments (yields).
+  FacetMesh& m = facets_[f];
+  const MeshId mesh = FacetMeshId(f);
+  const double theta_r2 = (options_.theta * r) * (options_.theta * r);
+  for (int attempt = 0;; ++attempt) {
+    if (attempt > 100000) return absl::InternalError("SVRC: Destroy (facet) yielded without end");
+    const VertexId2 w = m.dt().NearestVertex(c, hint);
+    CellsMeetingDisk(f, c, r, w, &bfs2_);
+    stats_.destroy_cells_visited += bfs2_.size();
+    BallId warp, yield;
+    double warp_d2 = 0;
+    ++ball_stamp_;
+    if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
+    for (VertexId2 u : bfs2_) {
+      balls_scratch_.clear();
+      blg_.BallsOf(mesh, u.value(), &balls_scratch_);
+      for (BallId b : balls_scratch_) {
+        if (ball_mark_[b.value()] == ball_stamp_) continue;
+        ball_mark_[b.value()] = ball_stamp_;
+        if (!(balls_.CdOf(b) < kCdFacet) || !balls_.IsAlive(b)) continue;
+        if (balls_.IsVertexBall(b)) {
+          const PointId p = balls_.VertexPoint(b);
+          if (points_.InMesh(p, mesh)) continue;
+          const Vec2 q = Uv(f, p);
+          const double d2 = (q.x - c.x) * (q.x - c.x) + (q.y - c.y) * (q.y - c.y);
+          if (d2 > theta_r2) continue;
+          if (warp.valid()) {
+            const Cd a = balls_.CdOf(b), wc = balls_.CdOf(warp);
+            if (!(a < wc || (a == wc && (d2 < warp_d2 || (d2 == warp_d2 && p < balls_.VertexPoint(warp)))))) continue;
+          }
+          warp = b;
+          warp_d2 = d2;
+        } else if (balls_.NumVertices(b) == 2) {
+          const Vec2 ua = Uv(f, balls_.Vertex(b, 0)), ub = Uv(f, balls_.Vertex(b, 1));
+          // Yield when c is deeply inside the piece's disk, or when the
+          // triangle being destroyed straddles the piece: such a triangle is
+          // "in F" only until the piece conforms (guide §5 item 4), and
+          // splitting it while the piece is not an edge of M_F refines the
+          // wrong side of the segment against the neighbouring facet's points
+          // (measured: box_internal_facet ran to the vertex budget).
+          const bool straddles =
+              tri.valid() && m.dt().IsAlive(tri) &&
+              TriangleMeetsSegment(m.dt().Point(m.dt().TriVertex(tri, 0)), m.dt().Point(m.dt().TriVertex(tri, 1)),
+                                   m.dt().Point(m.dt().TriVertex(tri, 2)), ua, ub);
+          if (straddles) ++stats_.straddle_yields;
+          if (!straddles && (!DeepInside2(Mid2(ua, ub), HalfLen2(ua, ub), c) || geom::InDiametralCircle(ua, ub, c) <= 0)) {
+            continue;
+          }
+          if (yield.valid()) {
+            const Cd a = balls_.CdOf(b), y = balls_.CdOf(yield);
+            if (!(a < y || (a == y && (balls_.Radius(b) > balls_.Radius(yield) ||
+                                       (balls_.Radius(b) == balls_.Radius(yield) && b < yield))))) {
+              continue;
+            }
+          }
+          yield = b;
+        }
+      }
+    }
+    if (getenv("SVRC_DEBUG3") && tri.valid()) {
+      const auto& dt = m.dt();
+      fprintf(stderr, "TRI f=%u c=(%g %g) r=%g warp=%d yield=%d cells=%zu in_facet=%d verts:", f, c.x, c.y, r, warp.valid(), yield.valid(), bfs2_.size(), (int)m.InFacet(tri));
+      for (int k = 0; k < 3; ++k) { Vec2 q = dt.Point(dt.TriVertex(tri, k)); fprintf(stderr, " (%g %g | %d)", q.x, q.y, (int)m.region().Locate(q)); }
+      fprintf(stderr, "\n");
+    }
+    if (warp.valid()) {
+      ++stats_.warps;
+      const PointId p = balls_.VertexPoint(warp);
+      std::vector<uint32_t> cells;
+      blg_.CellsOf(LocationObject::Ball(warp), mesh, &cells);
+      const TriId2 h = cells.empty() ? hint : m.dt().VertexTri(VertexId2(cells[0]));
+      return ForceInsertFacet(f, p, Uv(f, p), h);
+    }
+    if (!yield.valid()) {
+      if (!(c.x >= m.SquareLo().x && c.x <= m.SquareHi().x && c.y >= m.SquareLo().y && c.y <= m.SquareHi().y)) {
+        return absl::InternalError(absl::StrCat("SVRC: facet ", f, " gap ball centre (", c.x, ", ", c.y, ") r=", r, " outside its square Ω_F [", m.SquareLo().x, ",", m.SquareHi().x, "]x[", m.SquareLo().y, ",", m.SquareHi().y, "]"));
+      }
+      const PointId p = points_.Add(frames_[f].ToSpace(c), features_.OfFacet(f), kCdFacet);
+      return ForceInsertFacet(f, p, c, hint);
+    }
+    ++stats_.yields;
+    absl::Status st = DestroySegmentPiece(piece_seg_[yield.value()], piece_vertex_[yield.value()]);
+    if (!st.ok()) return st;
+  }
 }
 
 absl::Status Refiner::DestroySegmentPiece(uint32_t seg, uint32_t u) {
@@ -500,9 +947,7 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
           warp_d2 = d2;
         } else if (balls_.IsAlive(b)) {
           // Strict interior: c on the sphere does not force a yield.
-          if (geom::InDiametralSphere(points_.Xyz(balls_.Vertex(b, 0)), points_.Xyz(balls_.Vertex(b, 1)), c) <= 0) {
-            continue;
-          }
+          if (!Inside(b, c)) continue;
           // Lowest CD, then the largest ball, then lowest id.
           if (yield.valid()) {
             const Cd a = balls_.CdOf(b), y = balls_.CdOf(yield);
@@ -517,20 +962,46 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
     }
     if (warp.valid()) {
       ++stats_.warps;
+      if (getenv("SVRC_WATCH") && v.value() == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
+        const Vec3 q = points_.Xyz(balls_.VertexPoint(warp));
+        fprintf(stderr, "WATCH warp to point %u cd=%s q=(%.17g %.17g %.17g) c=(%.17g %.17g %.17g) d=%g r=%g\n", balls_.VertexPoint(warp).value(),
+                CdToString(balls_.CdOf(warp)).c_str(), q.x, q.y, q.z, c.x, c.y, c.z, std::sqrt(warp_d2), r);
+        std::vector<TetId> st;
+        omega_.dt().Star(v, &st);
+        for (TetId t : st) {
+          if (omega_.dt().IsGhost(t)) { fprintf(stderr, "  ghost\n"); continue; }
+          const Vec3 cc = omega_.dt().Circumcenter(t);
+          bool has = false;
+          for (int k = 0; k < 4; ++k) has = has || omega_.dt().TetVertex(t, k) == v;
+          if (!has || !omega_.dt().IsAlive(t)) fprintf(stderr, "  STALE tet %u alive=%d has=%d\n", t.value(), (int)omega_.dt().IsAlive(t), (int)has);
+          fprintf(stderr, "  tet %u cc=(%g %g %g) R=%g |cc-c|=%g |q-cc|=%g\n", t.value(), cc.x, cc.y, cc.z,
+                  geom::Dist(cc, omega_.dt().Point(v)), geom::Dist(cc, c), geom::Dist(q, cc));
+        }
+      }
       std::vector<uint32_t> cells;
       blg_.CellsOf(LocationObject::Ball(warp), kOmegaMesh, &cells);
       const TetId hint = cells.empty() ? s.hint : omega_.dt().VertexTet(VertexId(cells[0]));
       return ForceInsertOmega(balls_.VertexPoint(warp), hint);
     }
     if (!yield.valid()) {
-      // Line 11: insert the centre.
+      // Line 11: insert the centre. A clipped corner on ∂Ω is a rounded
+      // intersection; it can be bit-identical to a vertex already inserted
+      // there from a neighbouring cell whose exact cell kept it (so v's cell
+      // did not change and its event came back). The gap ball is then not
+      // empty: nothing to destroy.
+      const VertexId near = omega_.dt().NearestVertex(c, s.hint);
+      if (omega_.dt().Point(near) == c) {
+        ++stats_.phantom_corners;
+        if (getenv("SVRC_DEBUG")) fprintf(stderr, "PHANTOM cell %u at (%g %g %g)\n", v.value(), c.x, c.y, c.z);
+        return absl::OkStatus();
+      }
       return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), kCdSpace), s.hint);
     }
     // Lines 13–14: destroy the lower ball first (one insertion into M_s), then
     // start over: the new segment point may now be a warp target. M_Ω did not
     // change, so the gap ball is still ours.
     ++stats_.yields;
-    absl::Status st = DestroySegmentPiece(piece_seg_[yield.value()], piece_vertex_[yield.value()]);
+    absl::Status st = DestroyBall(yield);
     if (!st.ok()) return st;
   }
 }
@@ -544,7 +1015,11 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   if (result.outcome != delaunay::Delaunay3::InsertOutcome::kInserted) {
     // Duplicate input points were merged at Initialize and a warp target lying
     // in B is warped to rather than inserted next to, so a coincidence is a bug.
-    return absl::InternalError(absl::StrCat("SVRC: point ", p.value(), " coincides with a vertex of M_Ω"));
+    const PointId q = omega_.PointOf(result.vertex);
+    return absl::InternalError(absl::StrCat("SVRC: point ", p.value(), " (CD ", CdToString(points_.CdOf(p)), ", feature ",
+                                            points_.Parent(p).value(), ") coincides with point ", q.value(), " (CD ",
+                                            CdToString(points_.CdOf(q)), ", feature ", points_.Parent(q).value(),
+                                            ") of M_Ω at (", pos.x, ", ", pos.y, ", ", pos.z, ")"));
   }
   ++stats_.insertions;
   const VertexId nv = result.vertex;
@@ -557,6 +1032,13 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // scratch, which later queries reuse.
   std::vector<VertexId> changed(result.cavity_vertices.begin(), result.cavity_vertices.end());
   changed.push_back(nv);
+  if (getenv("SVRC_WATCH")) {
+    const uint32_t w = atoi(getenv("SVRC_WATCH"));
+    bool in = false;
+    for (VertexId u : changed) in = in || u.value() == w;
+    if (p.value() == 828) fprintf(stderr, "WATCH validate: %s\n", dt.Validate(true).ToString().c_str());
+    if (p.value() == 828) fprintf(stderr, "WATCH insert p=%u nv=%u changed=%zu has_watch=%d created=%zu destroyed=%zu\n", p.value(), nv.value(), changed.size(), (int)in, result.created.size(), result.destroyed.size());
+  }
   for (VertexId u : changed) omega_.BumpCell(u);
   std::vector<CellSize> sizes(changed.size());
   for (size_t i = 0; i < changed.size(); ++i) sizes[i] = omega_.Size(changed[i]);
@@ -597,7 +1079,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     const double r = balls_.Radius(b);
     for (size_t i = 0; i < changed.size(); ++i) {
       if (geom::Dist(dt.Point(changed[i]), c) <= (r + sizes[i].outradius) * (1 + 1e-9)) {
-        AddPieceLink(changed[i], b);
+        AddBallLink(changed[i], b);
       }
     }
   }
@@ -622,6 +1104,13 @@ absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t) {
   const BallId old_piece = m.PieceBall(u);
   std::vector<uint32_t> old_cells;
   balls_.Kill(old_piece);
+  std::vector<TriId2> facet_hint(seg_facets_[seg].size());
+  for (size_t i = 0; i < seg_facets_[seg].size(); ++i) {
+    const uint32_t fc = seg_facets_[seg][i];
+    blg_.RemoveObjectLinks(LocationObject::Ball(old_piece), FacetMeshId(fc), &old_cells);
+    if (!old_cells.empty()) facet_hint[i] = facets_[fc].dt().VertexTri(VertexId2(old_cells[0]));
+    old_cells.clear();
+  }
   blg_.RemoveObjectLinks(LocationObject::Ball(old_piece), kOmegaMesh, &old_cells);
   const BallId left = balls_.AddPieceBall(m.PointOf(u), p, points_.Xyz(m.PointOf(u)), points_.Xyz(p), f, mesh);
   const BallId right = balls_.AddPieceBall(p, m.PointOf(w), points_.Xyz(p), points_.Xyz(m.PointOf(w)), f, mesh);
@@ -637,8 +1126,15 @@ absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t) {
   piece_vertex_[left.value()] = u;
   piece_vertex_[right.value()] = mid;
   piece_seg_[left.value()] = piece_seg_[right.value()] = seg;
-  // PropagateLocation (3.9) to the superfeatures of a free segment: M_Ω only.
-  // New objects are located by a search from the old piece's cells.
+  // PropagateLocation (3.9) to the superfeatures: the facets containing the
+  // segment, then M_Ω. New objects are located by a search from the old
+  // piece's cells.
+  for (size_t i = 0; i < seg_facets_[seg].size(); ++i) {
+    const uint32_t fc = seg_facets_[seg][i];
+    LinkPieceToFacet(left, fc, facet_hint[i]);
+    LinkPieceToFacet(right, fc, facet_hint[i]);
+    LinkVertexBallToFacet(vb, fc, facet_hint[i]);
+  }
   const VertexId start = old_cells.empty() ? VertexId(0) : VertexId(old_cells[0]);
   LinkBallToOmega(left, start);
   LinkBallToOmega(right, start);
@@ -649,6 +1145,91 @@ absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t) {
   RefreshSegmentEvents(seg, u);
   RefreshSegmentEvents(seg, mid);
   RefreshSegmentEvents(seg, w);
+  return absl::OkStatus();
+}
+
+absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hint) {
+  FacetMesh& m = facets_[f];
+  const MeshId mesh = FacetMeshId(f);
+  const delaunay::Delaunay2::InsertResult r = m.Insert(uv, p, hint);
+  if (r.outcome != delaunay::Delaunay2::InsertOutcome::kInserted) {
+    return absl::InternalError(absl::StrCat("SVRC: point ", p.value(), " could not be inserted into facet mesh ", f,
+                                            r.outcome == delaunay::Delaunay2::InsertOutcome::kDuplicate
+                                                ? " (coincides with a vertex)"
+                                                : " (outside Ω_F)"));
+  }
+  const bool steiner = points_.Parent(p) == features_.OfFacet(f);  // created by this mesh
+  if (steiner) ++stats_.facet_vertices;
+  const VertexId2 nv = r.vertex;
+  points_.SetVertex(p, mesh, nv.value());
+  // Copies: the spans point into Delaunay2 scratch.
+  std::vector<VertexId2> changed(r.cavity_vertices.begin(), r.cavity_vertices.end());
+  changed.push_back(nv);
+  const std::vector<TriId2> created(r.created.begin(), r.created.end());
+  // UpdateLocation (3.6) (b)/(d): the triangle balls of destroyed in-facet
+  // triangles die (unlinked from M_Ω), the new in-facet triangles get balls.
+  std::vector<BallId> killed;
+  m.SyncTriangleBalls(r, frames_[f], features_.OfFacet(f), mesh, &balls_, nullptr, &killed);
+  std::vector<uint32_t> omega_cells;
+  for (BallId b : killed) blg_.RemoveObjectLinks(LocationObject::Ball(b), kOmegaMesh, omega_cells.empty() ? &omega_cells : nullptr);
+  // p's own 0-ball is resolved in M_F.
+  const BallId own = VertexBallOf(p);
+  if (own.valid()) blg_.RemoveObjectLinks(LocationObject::Ball(own), mesh, nullptr);
+  std::vector<CellSize2> sizes(changed.size());
+  for (size_t i = 0; i < changed.size(); ++i) sizes[i] = m.Size(changed[i]);
+  // (c): re-link the lower balls of the old cells to the new cells.
+  ++ball_stamp_;
+  if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
+  std::vector<BallId> moved_pieces;
+  const delaunay::Delaunay2& dt = m.dt();
+  for (size_t i = 0; i + 1 < changed.size(); ++i) {
+    const VertexId2 u = changed[i];
+    objects_.clear();
+    blg_.RemoveCellLinks(mesh, u.value(), &objects_);
+    const Vec2 pu = dt.Point(u);
+    for (const LocationObject& o : objects_) {
+      const BallId b(o.id);
+      if (!balls_.IsAlive(b)) continue;
+      if (!balls_.IsVertexBall(b)) {
+        if (ball_mark_[b.value()] != ball_stamp_) {
+          ball_mark_[b.value()] = ball_stamp_;
+          moved_pieces.push_back(b);
+        }
+        continue;
+      }
+      const PointId q = balls_.VertexPoint(b);
+      if (points_.InMesh(q, mesh)) continue;
+      const int cmp = geom::CompareDistance(Uv(f, q), pu, uv);  // > 0: u is farther
+      const bool to_new = cmp > 0 || (cmp == 0 && p.value() < m.PointOf(u).value());
+      LinkFacts facts;
+      facts.unresolved = true;
+      blg_.AddLink(mesh, to_new ? nv.value() : u.value(), o, facts, &balls_);
+    }
+  }
+  for (BallId b : moved_pieces) {
+    const Vec2 a = Uv(f, balls_.Vertex(b, 0)), c = Uv(f, balls_.Vertex(b, 1));
+    const Vec2 mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
+    const double rad = 0.5 * std::hypot(a.x - c.x, a.y - c.y);
+    for (size_t i = 0; i < changed.size(); ++i) {
+      const Vec2 x = dt.Point(changed[i]);
+      if (std::hypot(x.x - mid.x, x.y - mid.y) <= (rad + sizes[i].outradius) * (1 + 1e-9)) {
+        AddFacetPieceLink(f, changed[i], b);
+      }
+    }
+  }
+  const VertexId start = omega_cells.empty() ? VertexId(0) : VertexId(omega_cells[0]);
+  // (b): a point M_F created inside (the closure of) F gets a 0-ball, which
+  // PropagateLocation hands to M_Ω, where it is unresolved until inserted;
+  // points of Ω_F outside F stay scaffolding of M_F (Figure 3.6, "kept if
+  // dim(T ∩ F) = dim T").
+  if (steiner && m.region().Locate(uv) != FacetRegion::Where::kOutside) {
+    const BallId vb = balls_.AddVertexBall(p, points_.Xyz(p), features_.OfFacet(f), mesh, kCdFacet);
+    SetVertexBall(p, vb);
+    LinkVertexBallToOmega(vb, start);
+  }
+  AdoptTriangleBalls(f, created, start);
+  // Figure 3.5's loop over 𝒱'.
+  for (size_t i = 0; i < changed.size(); ++i) RefreshFacetEvents(f, changed[i], &sizes[i]);
   return absl::OkStatus();
 }
 
@@ -691,13 +1272,19 @@ absl::Status Refiner::CheckInvariants(bool final) {
     const VertexId v(w);
     const CellSize cs = omega_.Size(v);
     if (!IsSkinny(cs)) continue;
-    if (final) {
+    if (final && dt.Point(dt.NearestVertex(cs.corner, cs.hint)) != cs.corner) {
       return absl::InternalError(absl::StrCat("SVRC invariant: cell ", w, " skinny at the end: R/r = ",
                                               cs.outradius / cs.inradius));
     }
     const EventHandle h = omega_.SkinnyEvent(v);
+    const VertexId near = dt.NearestVertex(cs.corner, cs.hint);
+    if (dt.Point(near) == cs.corner) continue;  // a phantom corner (DestroyOmega skips it)
     if (!queues_.IsQueued(h) || queues_.Get(h).generation != omega_.CellGeneration(v)) {
-      return absl::InternalError(absl::StrCat("SVRC invariant: skinny cell ", w, " has no live Skinny event"));
+      return absl::InternalError(absl::StrCat("SVRC invariant: skinny cell ", w, " has no live Skinny event; corner (",
+                                              cs.corner.x, ", ", cs.corner.y, ", ", cs.corner.z, ") R=", cs.outradius,
+                                              " r=", cs.inradius, " clipped=", cs.clipped, " queued=", queues_.IsQueued(h) ? 1 : 0, " evgen=",
+                                              queues_.IsQueued(h) ? queues_.Get(h).generation : 0, " cellgen=",
+                                              omega_.CellGeneration(v)));
     }
   }
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
@@ -737,12 +1324,118 @@ absl::Status Refiner::CheckInvariants(bool final) {
   return absl::OkStatus();
 }
 
+void Refiner::OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces_out,
+                             std::vector<std::array<uint32_t, 2>>* edges_out) const {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  auto& faces = *faces_out;
+  auto& edges = *edges_out;
+  faces.clear();
+  edges.clear();
+  for (TetId t : dt.FiniteTets()) {
+    std::array<uint32_t, 4> v;
+    for (int k = 0; k < 4; ++k) v[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
+    std::sort(v.begin(), v.end());
+    faces.push_back({v[0], v[1], v[2]});
+    faces.push_back({v[0], v[1], v[3]});
+    faces.push_back({v[0], v[2], v[3]});
+    faces.push_back({v[1], v[2], v[3]});
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) edges.push_back({v[i], v[j]});
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+}
+
+bool Refiner::EnqueueMissing() {
+  std::vector<std::array<uint32_t, 3>> faces;
+  std::vector<std::array<uint32_t, 2>> edges;
+  OmegaSimplices(&faces, &edges);
+  bool more = false;
+  std::vector<std::vector<std::array<uint32_t, 2>>> facet_edges(facets_.size());
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    const delaunay::Delaunay2& dt = facets_[f].dt();
+    for (TriId2 t : dt.Triangles()) {
+      for (int i = 0; i < 3; ++i) {
+        std::array<uint32_t, 2> e{facets_[f].PointOf(dt.TriVertex(t, i)).value(),
+                                  facets_[f].PointOf(dt.TriVertex(t, (i + 1) % 3)).value()};
+        std::sort(e.begin(), e.end());
+        facet_edges[f].push_back(e);
+      }
+    }
+    std::sort(facet_edges[f].begin(), facet_edges[f].end());
+  }
+  for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
+    SegmentMesh& m = segs_[sg];
+    for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
+      std::array<uint32_t, 2> e{m.PointOf(v).value(), m.PointOf(m.Next(v)).value()};
+      std::sort(e.begin(), e.end());
+      bool missing = !std::binary_search(edges.begin(), edges.end(), e);
+      for (uint32_t fc : seg_facets_[sg]) {
+        missing = missing || !std::binary_search(facet_edges[fc].begin(), facet_edges[fc].end(), e);
+      }
+      if (missing) {
+        ++stats_.tied_balls;
+        EnqueueEncroached(m.PieceBall(v));
+        more = true;
+      }
+    }
+  }
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    const delaunay::Delaunay2& dt = facets_[f].dt();
+    for (TriId2 t : dt.Triangles()) {
+      const BallId b = facets_[f].TriBall(t);
+      if (!b.valid()) continue;
+      std::array<uint32_t, 3> k{balls_.Vertex(b, 0).value(), balls_.Vertex(b, 1).value(), balls_.Vertex(b, 2).value()};
+      std::sort(k.begin(), k.end());
+      if (!std::binary_search(faces.begin(), faces.end(), k)) {
+        ++stats_.tied_balls;
+        EnqueueEncroached(b);
+        more = true;
+      }
+    }
+  }
+  return more;
+}
+
+absl::Status Refiner::VerifyConformity() const {
+  std::vector<std::array<uint32_t, 3>> faces;
+  std::vector<std::array<uint32_t, 2>> edges;
+  OmegaSimplices(&faces, &edges);
+  for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
+    const SegmentMesh& m = segs_[sg];
+    for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
+      std::array<uint32_t, 2> e{m.PointOf(v).value(), m.PointOf(m.Next(v)).value()};
+      std::sort(e.begin(), e.end());
+      if (!std::binary_search(edges.begin(), edges.end(), e)) {
+        return absl::InternalError(absl::StrCat("SVRC: piece (", e[0], ", ", e[1], ") of segment ", sg,
+                                                " is not an edge of M_Ω"));
+      }
+    }
+  }
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    for (const auto& tri : facets_[f].InFacetTriangles()) {
+      std::array<uint32_t, 3> k{tri[0].value(), tri[1].value(), tri[2].value()};
+      std::sort(k.begin(), k.end());
+      if (!std::binary_search(faces.begin(), faces.end(), k)) {
+        return absl::InternalError(absl::StrCat("SVRC: in-facet triangle (", k[0], ", ", k[1], ", ", k[2],
+                                                ") of facet ", f, " is not a face of M_Ω"));
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
 PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   const delaunay::Delaunay3& dt = omega_.dt();
   PointSetRefinement out;
   out.num_input = num_input_;
   out.positions.resize(points_.size());
+  out.normalised_positions.resize(points_.size());
   for (uint32_t i = 0; i < points_.size(); ++i) {
+    out.normalised_positions[i] = points_.Xyz(PointId(i));
     // Inputs come back bit-exactly from the original array; Steiner points
     // through the exact-scale, one-rounding back map.
     out.positions[i] = i < num_input_ ? input[i] : norm_.Backward(points_.Xyz(PointId(i)));
@@ -754,6 +1447,8 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
     out.tets.push_back(tet);
   }
+  out.normalisation_translation = norm_.translation;
+  out.normalisation_exponent = norm_.exponent;
   out.omega.Add(norm_.Backward(omega_.cube().lo));
   out.omega.Add(norm_.Backward(omega_.cube().hi));
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
@@ -764,10 +1459,21 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     out.segment_chains.push_back(std::move(chain));
   }
 
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    std::vector<std::array<uint32_t, 3>> tris;
+    for (const auto& tri : facets_[f].InFacetTriangles()) tris.push_back({tri[0].value(), tri[1].value(), tri[2].value()});
+    out.facet_triangles.push_back(std::move(tris));
+  }
   RefineStats& st = stats_;
   st.vertices = dt.NumVertices();
   st.input_vertices = num_input_ - st.duplicates;
-  st.steiner_vertices = st.vertices - 8 - st.input_vertices - st.segment_vertices;
+  for (uint32_t i = 0; i < points_.size(); ++i) {
+    if (points_.CdOf(PointId(i)) == kCdFacet && points_.Parent(PointId(i)) != FeatureTable::Omega() &&
+        points_.InMesh(PointId(i), kOmegaMesh)) {
+      ++st.facet_vertices_in_omega;
+    }
+  }
+  st.steiner_vertices = st.vertices - 8 - st.input_vertices - st.segment_vertices - st.facet_vertices_in_omega;
   const WorkQueues::Stats& q = queues_.stats();
   for (int i = 0; i < kNumEventTypes; ++i) {
     st.events_pushed[i] = q.pushed[i];
@@ -797,6 +1503,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.vertices", static_cast<double>(vertices));
   out->Set("svrc.vertices_dim0", static_cast<double>(input_vertices));
   out->Set("svrc.vertices_dim1", static_cast<double>(segment_vertices));
+  out->Set("svrc.vertices_dim2", static_cast<double>(facet_vertices_in_omega));
+  out->Set("svrc.facet_mesh_vertices", static_cast<double>(facet_vertices));
   out->Set("svrc.vertices_dim3", static_cast<double>(steiner_vertices));
   out->Set("svrc.insertions", static_cast<double>(insertions));
   out->Set("svrc.warps", static_cast<double>(warps));
@@ -845,6 +1553,55 @@ absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const Vec3>
     if (!s.ok()) return s;
   }
   return refiner.Output(points);
+}
+
+absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex, const RefineOptions& options) {
+  if (!(options.tau > 0) || !(options.theta > 0 && options.theta < 1)) {
+    return absl::InvalidArgumentError("SVRC: need tau > 0 and 0 < theta < 1");
+  }
+  if (complex.points.empty()) return absl::InvalidArgumentError("SVRC: the PLC has no points");
+  // Creases (Definitions 4–5) need collars (issue #6): refuse them up front,
+  // naming the first, rather than refine towards the budget.
+  for (uint32_t s = 0; s < complex.segments.size(); ++s) {
+    const plc::FeatureSegment& fs = complex.segments[s];
+    if (fs.crease) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "SVRC: crease at segment (", fs.a, ", ", fs.b, "): features meet at ", fs.min_angle * 180 / M_PI,
+          " degrees < 90; creases need collars, not implemented yet"));
+    }
+  }
+  for (uint32_t i = 0; i < complex.points.size(); ++i) {
+    if (complex.points[i].crease) {
+      const Vec3& p = complex.points[i].p;
+      return absl::FailedPreconditionError(absl::StrCat("SVRC: crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,
+                                                        "): features meet below 90 degrees; creases need collars, "
+                                                        "not implemented yet"));
+    }
+  }
+  std::vector<Vec3> input(complex.points.size());
+  for (size_t i = 0; i < input.size(); ++i) input[i] = complex.points[i].p;
+  absl::StatusOr<Normalization> norm = ChooseNormalization(input);
+  if (!norm.ok()) return norm.status();
+  std::vector<Vec3> normalised(input.size());
+  geom::Box3 box;
+  for (size_t i = 0; i < input.size(); ++i) {
+    normalised[i] = norm->Forward(input[i]);
+    box.Add(normalised[i]);
+  }
+  const double diam = box.Diagonal();
+  const double half = diam > 0 ? 1.5 * diam : 0.5;
+  Refiner refiner(options, *norm, box.Center(), half);
+  absl::Status s = refiner.Setup(complex, normalised);
+  if (!s.ok()) return s;
+  s = refiner.Run();
+  if (!s.ok()) return s;
+  if (options.validate_every > 0) {
+    s = refiner.CheckInvariants(/*final=*/true);
+    if (!s.ok()) return s;
+  }
+  s = refiner.VerifyConformity();
+  if (!s.ok()) return s;
+  return refiner.Output(input);
 }
 
 absl::StatusOr<PointSetRefinement> RefinePointSet(std::span<const Vec3> points,

@@ -17,6 +17,7 @@
 #include "absl/status/statusor.h"
 #include "core/geometry/vec3.h"
 #include "core/mesh/tet_mesh.h"
+#include "core/plc/features.h"
 
 namespace svrc::refine {
 
@@ -33,6 +34,9 @@ struct RefineOptions {
   // status aborts the run and is returned. May be null.
   std::function<absl::Status()> poll;
   uint32_t poll_interval = 256;
+  // Called at every poll: vertices in all meshes, pending events, radius of
+  // the event about to be destroyed (the largest work radius). May be null.
+  std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;
   // > 0: check the stage-(a) invariants (guide §6 (a)) every that many
   // insertions, and always at the end. For tests; costs O(n·m) per check.
   uint32_t validate_every = 0;
@@ -44,10 +48,15 @@ struct RefineStats {
   uint64_t input_vertices = 0;     // (dimension 0)
   uint64_t steiner_vertices = 0;   // created in M_Ω (dimension 3), corners excluded
   uint64_t segment_vertices = 0;   // created in segment meshes (dimension 1)
+  uint64_t facet_vertices = 0;     // created in facet meshes (dimension 2), in F or not
+  uint64_t facet_vertices_in_omega = 0;  // of those, in M_Ω at the end (inside their facet)
   uint64_t insertions = 0;
   uint64_t warps = 0;              // Destroy line 6
   uint64_t yields = 0;             // Destroy line 13
   uint64_t duplicates = 0;         // warp targets equal to an existing vertex
+  uint64_t phantom_corners = 0;    // clipped cell corners equal to an existing vertex (skipped)
+  uint64_t tied_balls = 0;
+  uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
@@ -85,6 +94,15 @@ struct PointSetRefinement {
   // Per input segment: its vertices from a to b as position indices (a chain
   // of edges of the tets; stage (b)).
   std::vector<std::vector<uint32_t>> segment_chains;
+  // Stage (c), RefinePlc only: `positions` in the mesher's (normalised)
+  // coordinates, the tets are positively oriented in them.
+  std::vector<geom::Vec3> normalised_positions;
+  // The exact map x' = (x − t)·2^−e from input to normalised coordinates.
+  geom::Vec3 normalisation_translation{0, 0, 0};
+  int normalisation_exponent = 0;
+  // Per facet of the complex: its in-facet triangles (position indices), each
+  // a face of `tets` (checked before returning).
+  std::vector<std::vector<std::array<uint32_t, 3>>> facet_triangles;
   RefineStats stats;
 };
 
@@ -111,5 +129,16 @@ struct SegmentInput {
 absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const geom::Vec3> points,
                                                            std::span<const SegmentInput> segments,
                                                            const RefineOptions& options);
+
+// Stage (c): a validated PLC's feature complex (plc::PreparePlc) — points,
+// segments, facets (with holes, in-facet segments and points). Refuses
+// creases (two features meeting below 90°, complex crease flags) with
+// FAILED_PRECONDITION naming the first one: they need collars (issue #6).
+// Otherwise as RefinePointsAndSegments, plus: every in-facet triangle of
+// every facet mesh is a face of the output tets (`facet_triangles`), every
+// facet-mesh and segment-mesh cell is τ-well-spaced. Position i < number of
+// complex points is complex point i (input coordinates, bit-exact).
+absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
+                                             const RefineOptions& options);
 
 }  // namespace svrc::refine
