@@ -63,7 +63,8 @@ void Delaunay3::Reserve(size_t num_vertices) {
   const size_t tets = num_vertices * 7 + 64;
   tets_.reserve(8 * tets);
   tet_gen_.reserve(tets);
-  tet_mark_.reserve(tets);
+  tet_bits_.reserve(tets / 64 + 1);
+  outside_bits_.reserve(tets / 64 + 1);
 }
 
 // ---------------------------------------------------------------------------
@@ -85,7 +86,8 @@ void Delaunay3::GrowTets() {
   const size_t cap = size_t{old_cap} + add;
   tets_.resize(8 * cap, kFreeSlot);
   tet_gen_.resize(cap, 0);
-  tet_mark_.resize(cap, 0);
+  tet_bits_.resize(cap / 64 + 1, 0);
+  outside_bits_.resize(cap / 64 + 1, 0);
   for (uint32_t t = static_cast<uint32_t>(cap); t-- > old_cap;) {
     tets_[8 * t + 4] = free_head_;
     free_head_ = t;
@@ -99,18 +101,6 @@ inline void Delaunay3::FreeTet(uint32_t t) {
   free_head_ = t;
   ++tet_gen_[t];
   --num_live_tets_;
-}
-
-// Returns the first of n tet-mark values never used before (marks are never
-// cleared; a wrap-around clears them all once).
-uint32_t Delaunay3::FreshStamps(uint32_t n) const {
-  if (mark_stamp_ >= 0xFFFFFF00u) {
-    std::fill(tet_mark_.begin(), tet_mark_.end(), 0);
-    mark_stamp_ = 0;
-  }
-  const uint32_t first = mark_stamp_ + 1;
-  mark_stamp_ += n;
-  return first;
 }
 
 // ---------------------------------------------------------------------------
@@ -259,14 +249,19 @@ Delaunay3::InsertResult Delaunay3::Insert(const Vec3& p, uint32_t global_id, Tet
 Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint32_t sos) {
   const Vec3 p = points_[v];
   const uint32_t gid = global_ids_[v];
-  const uint32_t in_cavity = FreshStamps(2);
-  const uint32_t outside = in_cavity + 1;  // tested, not in conflict
+  // Marks: tet_bits_ = in the cavity, outside_bits_ = tested, not in
+  // conflict. One bit per slot (the sets stay in cache; 32-bit stamps over
+  // millions of tets did not), all cleared again below from the lists.
+  uint64_t* in_cavity = tet_bits_.data();
+  uint64_t* outside = outside_bits_.data();
+  auto test = [](const uint64_t* bits, uint32_t t) { return (bits[t >> 6] >> (t & 63)) & 1; };
+  auto set = [](uint64_t* bits, uint32_t t) { bits[t >> 6] |= uint64_t{1} << (t & 63); };
 
   destroyed_.clear();
   boundary_.clear();
   stack_.clear();
   stack_.push_back(start);
-  tet_mark_[start] = in_cavity;
+  set(in_cavity, start);
   while (!stack_.empty()) {
     const uint32_t t = stack_.back();
     stack_.pop_back();
@@ -274,19 +269,22 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
     for (uint32_t f = 0; f < 4; ++f) {
       const uint32_t n = tets_[8 * t + 4 + f];
       const uint32_t u = n >> 2;
-      const uint32_t m = tet_mark_[u];
-      if (m == in_cavity) continue;
-      if (m != outside) {
+      if (test(in_cavity, u)) continue;
+      if (!test(outside, u)) {
         if (ConflictRaw(u, p, gid, &sos)) {
-          tet_mark_[u] = in_cavity;
+          set(in_cavity, u);
           stack_.push_back(u);
           continue;
         }
-        tet_mark_[u] = outside;
+        set(outside, u);
       }
       boundary_.push_back(4 * t + f);
     }
   }
+  // Every marked tet is in the cavity or across one of its boundary faces;
+  // set bits belong to this insertion only, so whole words can be zeroed.
+  for (TetId d : destroyed_) in_cavity[d.value() >> 6] = 0;
+  for (uint32_t bf : boundary_) outside[tets_[NRef(bf)] >> 8] = 0;
 
   // An exact duplicate only ever conflicts through the perturbation (p lies
   // on, never strictly inside, the spheres of the tets around its twin).
@@ -297,8 +295,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
         const uint32_t w = tets_[8 * t + i];
         if (w != kInf && w != v && points_[w] == p) {
           ++stats_.duplicates;
-          // Nothing was modified; clear the cavity marks.
-          for (TetId d : destroyed_) tet_mark_[d.value()] = 0;
+          // Nothing was modified (the marks are already cleared).
           destroyed_.clear();
           InsertResult r;
           r.outcome = InsertOutcome::kDuplicate;
@@ -340,7 +337,6 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
     const uint32_t o = new_outer_[k];
     tets_[8 * t + 4 + f] = o;
     tets_[NRef(o)] = 4 * t + f;
-    tet_mark_[t] = 0;
     for (uint32_t i = 0; i < 4; ++i) {
       if (i == f) continue;
       const uint64_t key = EdgeKey(tv[kEdge[f][i][0]], tv[kEdge[f][i][1]]);
@@ -374,22 +370,20 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
 
   cavity_vertices_.clear();
   if (report_cavity_vertices_) {
-    if (++vertex_stamp_ == 0) {
-      std::fill(vertex_mark_.begin(), vertex_mark_.end(), 0);
-      vertex_stamp_ = 1;
+    if (vertex_bits_.size() * 64 < points_.size()) {
+      vertex_bits_.resize(points_.size() / 64 + points_.size() / 128 + 1, 0);
     }
-    if (vertex_mark_.size() < points_.size()) {
-      vertex_mark_.resize(points_.size() + points_.size() / 2 + 16, 0);
-    }
+    uint64_t* seen = vertex_bits_.data();
     for (TetId ct : created_) {
       const uint32_t* tv = &tets_[8 * ct.value()];
       for (int i = 0; i < 4; ++i) {
         const uint32_t w = tv[i];
-        if (w == kInf || w == v || vertex_mark_[w] == vertex_stamp_) continue;
-        vertex_mark_[w] = vertex_stamp_;
+        if (w == kInf || w == v || test(seen, w)) continue;
+        set(seen, w);
         cavity_vertices_.push_back(VertexId(w));
       }
     }
+    for (VertexId w : cavity_vertices_) seen[w.value() >> 6] = 0;
   }
   last_tet_ = created_.back().value();
   ++stats_.inserted;
@@ -521,7 +515,6 @@ void Delaunay3::BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
   const uint32_t t0 = NewTet();
   const uint32_t tv[4] = {a, b, c, d};
   for (int i = 0; i < 4; ++i) tets_[8 * t0 + i] = tv[i];
-  tet_mark_[t0] = 0;
   created_.clear();
   for (int f = 0; f < 4; ++f) {
     // Replacing vertex f by ∞ gives a negatively oriented ghost; one
@@ -533,7 +526,6 @@ void Delaunay3::BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
     const uint32_t t = NewTet();
     for (int i = 0; i < 4; ++i) tets_[8 * t + i] = g[i];
     ++num_ghost_tets_;
-    tet_mark_[t] = 0;
     tets_[8 * t + 4 + 3] = 4 * t0 + f;
     tets_[8 * t0 + 4 + f] = 4 * t + 3;
     created_.push_back(TetId(t));

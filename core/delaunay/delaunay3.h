@@ -233,7 +233,6 @@ class Delaunay3 {
   uint32_t NewTet();
   void GrowTets();
   void FreeTet(uint32_t t);
-  uint32_t FreshStamps(uint32_t n) const;
   bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
   bool ConflictSlow(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
   uint32_t WalkRaw(const Vec3& p, uint32_t start, uint32_t* steps) const;
@@ -273,8 +272,6 @@ class Delaunay3 {
   static constexpr uint32_t NRef(uint32_t n) { return 8 * (n >> 2) + 4 + (n & 3); }
   std::vector<uint32_t> tets_;  // per tet: 4 vertices then 4 neighbours (one cache line per 2 tets)
   std::vector<uint32_t> tet_gen_;
-  mutable std::vector<uint32_t> tet_mark_;  // scratch stamps for searches
-  mutable uint32_t mark_stamp_ = 0;
   uint32_t free_head_ = kFreeSlot;
   uint32_t num_live_tets_ = 0;
   uint32_t num_ghost_tets_ = 0;
@@ -298,13 +295,14 @@ class Delaunay3 {
   std::vector<EdgeSlot> edge_table_;  // stamped open addressing: edge → 4t+f
   uint32_t edge_epoch_ = 0;
   uint32_t EdgeTableFor(size_t num_tets);
-  mutable std::vector<uint32_t> vertex_mark_;
-  mutable uint32_t vertex_stamp_ = 0;
   // Vertex-query scratch (WalkStar); sizes only grow.
   mutable std::vector<TetId> star_buf_;
   mutable std::vector<VertexId> nbr_buf_;
   mutable std::vector<TetId> nbr_tet_buf_;
-  mutable std::vector<uint64_t> tet_bits_, vertex_bits_;
+  // Scratch bitsets (all zero between calls): tet_bits_ over tet slots (star
+  // walks; the cavity during an insertion), outside_bits_ over tet slots
+  // (insertion: tested, not in conflict), vertex_bits_ over vertices.
+  mutable std::vector<uint64_t> tet_bits_, outside_bits_, vertex_bits_;
   bool cache_neighbors_ = false;
   mutable std::vector<AdjEntry> adj_;
   mutable std::vector<VertexId> adj_pool_;
