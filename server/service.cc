@@ -1,7 +1,6 @@
 #include "server/service.h"
 
 #include <mutex>
-#include <optional>
 #include <string>
 #include <utility>
 
@@ -9,6 +8,7 @@
 #include "proto/convert.h"
 #include "server/log.h"
 #include "server/status_util.h"
+#include "server/watch_stream.h"
 
 namespace svrc::server {
 namespace {
@@ -113,68 +113,57 @@ class UploadReactor final : public grpc::ServerReadReactor<v1::UploadJobRequest>
   bool have_header_ = false;
 };
 
-// WatchJob: the manager calls Push() with every snapshot of the job (under
-// its lock, so Push never blocks). One write is in flight at a time; newer
-// snapshots replace an unsent one, since each carries the whole job.
+// WatchJob: the manager calls the listener with every snapshot of the job
+// (under its lock, so it never blocks); WatchStream (server/watch_stream.h)
+// decides what to write: one write in flight, the newest unsent snapshot
+// next, the call finished after the terminal one.
 class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
  public:
   WatchReactor(JobManager* manager, const std::string& job_id,
                const absl::StatusOr<std::string>& owner)
       : manager_(manager), job_id_(job_id) {
     if (!owner.ok()) {
-      {
-        std::scoped_lock lock(mu_);
-        finished_ = true;
-      }
+      stream_.Close();
       Finish(ToGrpcStatus(owner.status()));
       return;
     }
-    absl::StatusOr<uint64_t> token =
-        manager_->Subscribe(job_id_, [this](const v1::JobEvent& e) { Push(e); }, *owner);
+    absl::StatusOr<uint64_t> token = manager_->Subscribe(
+        job_id_,
+        [this](const v1::JobEvent& e) {
+          if (stream_.Offer(e) == WatchStream::Action::kWrite) StartWrite(&stream_.in_flight());
+        },
+        *owner);
     if (!token.ok()) {
+      stream_.Close();
       Finish(ToGrpcStatus(token.status()));
       return;
     }
-    std::scoped_lock lock(mu_);
+    std::scoped_lock lock(token_mu_);
     token_ = *token;
   }
 
   void OnWriteDone(bool ok) override {
-    if (!ok) return;  // the stream broke: OnDone follows
-    bool finish = false;
-    {
-      std::scoped_lock lock(mu_);
-      writing_ = false;
-      if (pending_) {
-        in_flight_ = std::move(*pending_);
-        pending_.reset();
-        writing_ = true;
-      } else if (sent_terminal_) {
-        finish = !finished_;
-        finished_ = true;
-      }
-    }
-    if (finish) {
-      Finish(grpc::Status::OK);
-    } else {
-      MaybeWrite();
+    if (!ok) return;  // the stream broke: OnCancel/OnDone follow
+    switch (stream_.WriteDone()) {
+      case WatchStream::Action::kWrite:
+        StartWrite(&stream_.in_flight());
+        break;
+      case WatchStream::Action::kFinish:
+        Finish(grpc::Status::OK);
+        break;
+      case WatchStream::Action::kNone:
+        break;
     }
   }
 
   void OnCancel() override {
-    bool finish = false;
-    {
-      std::scoped_lock lock(mu_);
-      finish = !finished_;
-      finished_ = true;
-    }
-    if (finish) Finish(grpc::Status::CANCELLED);
+    if (stream_.Close()) Finish(grpc::Status::CANCELLED);
   }
 
   void OnDone() override {
     uint64_t token;
     {
-      std::scoped_lock lock(mu_);
+      std::scoped_lock lock(token_mu_);
       token = token_;
     }
     if (token != 0) manager_->Unsubscribe(job_id_, token);
@@ -182,42 +171,13 @@ class WatchReactor final : public grpc::ServerWriteReactor<v1::JobEvent> {
   }
 
  private:
-  void Push(const v1::JobEvent& event) {
-    {
-      std::scoped_lock lock(mu_);
-      if (finished_ || sent_terminal_) return;
-      if (writing_) {
-        pending_ = event;
-        if (api::IsTerminal(event.job().state())) sent_terminal_ = true;
-        return;
-      }
-      in_flight_ = event;
-      writing_ = true;
-      if (api::IsTerminal(event.job().state())) sent_terminal_ = true;
-    }
-    StartWrite(&in_flight_);
-  }
-
-  void MaybeWrite() {
-    {
-      std::scoped_lock lock(mu_);
-      if (!writing_) return;
-    }
-    StartWrite(&in_flight_);
-  }
-
   JobManager* manager_;
   const std::string job_id_;
-  // std::mutex (intercepted by TSan, unlike Debian's absl::Mutex). Taken
-  // inside the manager's lock (Push) and never the other way round. Guards
-  // token_, pending_, writing_, sent_terminal_ and finished_.
-  std::mutex mu_;
+  WatchStream stream_;
+  // std::mutex (intercepted by TSan, unlike Debian's absl::Mutex): token_ is
+  // set in the constructor and read in OnDone, on another thread.
+  std::mutex token_mu_;
   uint64_t token_ = 0;
-  v1::JobEvent in_flight_;  // owned by gRPC while writing_
-  std::optional<v1::JobEvent> pending_;
-  bool writing_ = false;
-  bool sent_terminal_ = false;  // the last event queued is terminal
-  bool finished_ = false;
 };
 
 // FetchResult: chunks read from the result store one at a time (a read of
