@@ -642,13 +642,15 @@ void Delaunay3::set_cache_neighbors(bool on) {
   adj_live_ = 0;
 }
 
-// Appends nbr_buf_[0, m) to the pool as v's list. The pool is compacted (in
-// vertex order) when most of it is stale.
+// Appends nbr_buf_[0, m) to the pool as v's list. When the pool is full it
+// is rebuilt with only the live lists (in vertex order) and room for half as
+// many again: copying is amortised over at least live/2 appends, and the pool
+// never holds more than ~1.5× the live lists (~3× while being rebuilt).
 void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
   if (adj_.size() <= v) adj_.resize(points_.size() + points_.size() / 2 + 16);
-  if (adj_pool_.size() + m > adj_pool_.capacity() && adj_pool_.size() > 4 * adj_live_ + 4096) {
+  if (adj_pool_.size() + m > adj_pool_.capacity()) {
     std::vector<VertexId> pool;
-    pool.reserve(2 * adj_live_ + 4096);
+    pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);
     for (AdjEntry& e : adj_) {
       if (e.size == kNoAdj) continue;
       const uint32_t off = static_cast<uint32_t>(pool.size());
