@@ -109,12 +109,19 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     return absl::InvalidArgumentError("radius_edge must be a positive number");
   }
   if (!(params.theta > 0 && params.theta < 1)) return absl::InvalidArgumentError("theta must be in (0, 1)");
+  // Not built yet: refuse rather than ignore (issue #5 size events, thesis
+  // §6.2.1 sliver removal).
+  if (params.max_volume > 0) {
+    return absl::UnimplementedError("max_volume: size-driven refinement is not implemented yet for PLCs");
+  }
+  if (params.min_dihedral > 0) {
+    return absl::UnimplementedError("min_dihedral: sliver removal is not implemented yet");
+  }
   report("validate", 0, 0, 0);
   plc::ValidationReport vreport;
   absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(plc, {}, {}, &vreport);
   if (!complex.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(plc.source_name.empty() ? "<memory>" : plc.source_name, ": ",
-                                                   complex.status().message()));
+    return complex.status();  // INVALID_ARGUMENT naming the source, ids and lines (plc/validate.h)
   }
   const double seconds_validate = elapsed();
   refine::RefineOptions options;

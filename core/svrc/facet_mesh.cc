@@ -147,6 +147,7 @@ FacetRegion BuildFacetRegion(const plc::FeatureComplex& complex, uint32_t facet,
     const plc::FeatureSegment& seg = complex.segments[s];
     r.segments.push_back({uv_of(seg.a), uv_of(seg.b)});
     r.segment_points.push_back({point_ids[seg.a], point_ids[seg.b]});
+    r.segment_ids.push_back(s);
   }
   for (plc::PointId p : f.interior_points) {
     r.interior_uv.push_back(uv_of(p));
@@ -196,9 +197,46 @@ Delaunay2::InsertResult FacetMesh::Insert(Vec2 uv, PointId id, TriId2 hint) {
   return r;
 }
 
+void FacetMesh::SetOnSegment(VertexId2 v, int32_t k) {
+  if (on_segment_.size() <= v.value()) on_segment_.resize(v.value() + 1, -1);
+  on_segment_[v.value()] = k;
+}
+
+bool FacetMesh::OnSegment(VertexId2 v, size_t k) const {
+  if (v.value() < on_segment_.size() && on_segment_[v.value()] == static_cast<int32_t>(k)) return true;
+  const PointId p = PointOf(v);
+  return p == region_.segment_points[k][0] || p == region_.segment_points[k][1];
+}
+
 bool FacetMesh::InFacet(TriId2 t) const {
-  return region_.TriangleInFacet(dt_.Point(dt_.TriVertex(t, 0)), dt_.Point(dt_.TriVertex(t, 1)),
-                                 dt_.Point(dt_.TriVertex(t, 2)));
+  const std::array<Vec2, 3> x = {dt_.Point(dt_.TriVertex(t, 0)), dt_.Point(dt_.TriVertex(t, 1)),
+                                 dt_.Point(dt_.TriVertex(t, 2))};
+  const Vec2 centroid{(x[0].x + x[1].x + x[2].x) / 3.0, (x[0].y + x[1].y + x[2].y) / 3.0};
+  if (region_.Locate(centroid) == FacetRegion::Where::kInside) return true;
+  // Straddling a segment of F (guide §5 item 4), decided with the points
+  // known to lie on it: a segment's Steiner points are rounded off its line
+  // (design §2), so the exact test against the input segment would call a
+  // triangle with an edge on the segment "crossing" it by a rounding hair.
+  // Two vertices on s: its side is its line, no crossing. One vertex on s:
+  // crossing iff the other two are strictly on opposite sides.
+  for (size_t k = 0; k < region_.segments.size(); ++k) {
+    const Vec2 s0 = region_.segments[k][0], s1 = region_.segments[k][1];
+    int on = 0;
+    std::array<int, 3> off{};
+    int n_off = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (OnSegment(dt_.TriVertex(t, i), k)) {
+        ++on;
+      } else {
+        off[n_off++] = i;
+      }
+    }
+    if (on >= 2) continue;
+    if (!TriangleMeetsSegment(x[0], x[1], x[2], s0, s1)) continue;
+    if (on == 1 && geom::Orient2d(s0, s1, x[off[0]]) * geom::Orient2d(s0, s1, x[off[1]]) >= 0) continue;
+    return true;
+  }
+  return false;
 }
 
 std::vector<std::array<PointId, 3>> FacetMesh::InFacetTriangles() const {
@@ -305,6 +343,10 @@ CellSize2 FacetMesh::Size(VertexId2 v) const {
       out.corner = c;
     }
   }
+  // A clipped corner is a rounded intersection with a side of Ω_F; keep it
+  // on the square (it may come out an ulp beyond), where it is inserted.
+  out.corner.x = std::clamp(out.corner.x, square_lo_.x, square_hi_.x);
+  out.corner.y = std::clamp(out.corner.y, square_lo_.y, square_hi_.y);
   out.outradius = best > 0 ? std::sqrt(best) : 0;
   out.hint = star_.front();
   return out;

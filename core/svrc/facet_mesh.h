@@ -33,6 +33,8 @@ struct FacetRegion {
   // Every segment of F (boundary and in-facet), as uv endpoint pairs.
   std::vector<std::array<geom::Vec2, 2>> segments;
   std::vector<std::array<PointId, 2>> segment_points;
+  std::vector<uint32_t> segment_ids;  // the complex's segment id of each
+
   // Isolated points in F's interior (they become vertices of M_F as well).
   std::vector<geom::Vec2> interior_uv;
   std::vector<PointId> interior_points;
@@ -121,8 +123,15 @@ class FacetMesh {
   PointId PointOf(VertexId2 v) const { return point_of_[v.value()]; }
   uint32_t NumVertices() const { return dt_.NumVertices(); }
 
-  // "Triangle in F" for a live triangle of M_F (guide §5 item 4).
+  // "Triangle in F" for a live triangle of M_F (guide §5 item 4): the
+  // centroid inside F, or straddling a segment of F — decided with the
+  // vertices known to lie on each segment (SetOnSegment, and the segments'
+  // endpoints), not by rounding (see facet_mesh.cc).
   bool InFacet(TriId2 t) const;
+  // Vertex v is a point of region segment k (a segment mesh's Steiner point);
+  // call before SyncTriangleBalls for the insertion that created v.
+  void SetOnSegment(VertexId2 v, int32_t k);
+  bool OnSegment(VertexId2 v, size_t k) const;
   // The live in-facet triangles, in slot order, as global point triples.
   std::vector<std::array<PointId, 3>> InFacetTriangles() const;
 
@@ -173,6 +182,7 @@ class FacetMesh {
   std::vector<uint32_t> cell_gen_;
   std::vector<EventHandle> skinny_event_, unresolved_event_;
   std::vector<BallId> tri_ball_;  // by triangle slot; kNoneBall: none
+  std::vector<int32_t> on_segment_;  // per vertex: region segment it lies on, -1: none
   mutable std::vector<Delaunay2::TriId> star_;
   mutable std::vector<VertexId2> nbrs_;
   mutable std::vector<geom::Vec2> poly_, scratch_;

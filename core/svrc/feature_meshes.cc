@@ -59,6 +59,15 @@ const OmegaMesh::CcEntry& OmegaMesh::CachedCircumcenter(TetId t) const {
     e.cc = dt_.Circumcenter(t);
     e.gen = g;
     e.inside = InsideCube(e.cc);
+    const Vec3& a = dt_.Point(dt_.TetVertex(t, 0));
+    const Vec3 ab = dt_.Point(dt_.TetVertex(t, 1)) - a, ac = dt_.Point(dt_.TetVertex(t, 2)) - a,
+               ad = dt_.Point(dt_.TetVertex(t, 3)) - a;
+    const double vol6 = std::fabs(geom::Dot(ab, geom::Cross(ac, ad)));
+    const double l2 = std::max({geom::Norm2(ab), geom::Norm2(ac), geom::Norm2(ad), geom::Dist2(ab, ac),
+                                geom::Dist2(ab, ad), geom::Dist2(ac, ad)});
+    double scale = 0;
+    for (int k = 0; k < 3; ++k) scale = std::max({scale, std::fabs(a[k]), std::fabs(e.cc[k])});
+    e.flat = vol6 <= 1e-9 * l2 * std::sqrt(l2) + 3e-14 * l2 * std::min(scale, 4.0 * half_side_) ? 1 : 0;
   }
   return e;
 }
@@ -139,6 +148,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v) const {
       break;
     }
     const CcEntry& e = CachedCircumcenter(t);
+    if (e.flat) continue;
     if (!e.inside) {
       needs_clip = true;
       break;
@@ -168,7 +178,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v) const {
     for (int guard = 0; guard < 1024; ++guard) {
       if (dt_.IsGhost(t)) {
         poly_.push_back(FarPoint(t));
-      } else {
+      } else if (!CachedCircumcenter(t).flat) {
         poly_.push_back(CachedCircumcenter(t).cc);
       }
       // The two faces of t containing v and u are opposite its other two vertices.

@@ -84,7 +84,14 @@ class OmegaMesh {
   struct CcEntry {
     geom::Vec3 cc;
     uint32_t gen = 0;     // generation + 1 of the cached value; 0: none
-    uint32_t inside = 0;  // InsideCube(cc)
+    uint16_t inside = 0;  // InsideCube(cc)
+    // Its four vertices are coplanar up to rounding (|volume| at noise level):
+    // four cocircular points of one facet, rounded off the plane. Its
+    // computed circumcentre is noise along the circle's axis, not a Voronoi
+    // vertex of the exact configuration, so R_v ignores it; the cell's
+    // corners on that axis are the circumcentres of the tets on either side,
+    // which share v (docs/svrc-design.md §10).
+    uint16_t flat = 0;
   };
   const CcEntry& CachedCircumcenter(TetId t) const;
   // A far point on the Voronoi ray of ghost tet g (outside Ω).

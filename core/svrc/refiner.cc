@@ -5,8 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <optional>
 #include <tuple>
@@ -48,6 +46,23 @@ bool DeepInside2(Vec2 c, double r, Vec2 x) {
   const double dx = x.x - c.x, dy = x.y - c.y;
   return dx * dx + dy * dy < r * r * (1 - 1e-9) - 1e-13 * r;
 }
+// A deterministic offset in [−1, 1) from a point id (splitmix64): the
+// Steiner points of facet and segment meshes are moved off the exact
+// circumcentre/midpoint by 10^−6 of the gap radius (docs/svrc-design.md §8
+// item 13). Exact midpoints and circumcentres of a dyadic facet mesh are
+// exactly cocircular in fours (square cells); rounded into M_Ω, four
+// cocircular coplanar points form flat tets on the facet (measured:
+// far_offset_close_points, 2 tets inverted by the back map). Off-centre
+// insertion is what warping does anyway (θ-medial points, Th. §3.1.1).
+double Jitter(uint64_t id, uint64_t salt) {
+  uint64_t z = id * 0x9E3779B97F4A7C15ull + salt;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
+}
+constexpr double kJitter = 1e-6;
+
 Vec2 Mid2(Vec2 a, Vec2 b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}; }
 double HalfLen2(Vec2 a, Vec2 b) { return 0.5 * std::hypot(a.x - b.x, a.y - b.y); }
 
@@ -548,11 +563,6 @@ void Refiner::AddBallLink(VertexId x, BallId b) {
   facts.native = points_.CdOf(p).dim == 3;  // CD(x) = dim Ω: created in M_Ω
   facts.vertex_point = p;
   const AddLinkResult r = blg_.AddLink(kOmegaMesh, x.value(), LocationObject::Ball(b), facts, &balls_);
-  if (getenv("SVRC_DEBUG2") && r.encroach == EncroachOutcome::kEnqueue && balls_.Radius(b) < atof(getenv("SVRC_DEBUG2"))) {
-    const Vec3& q = points_.Xyz(p);
-    fprintf(stderr, "ENC ball %u (nv=%d r=%g c=%g %g %g) by point %u cd=%d parent=%u xyz=(%g %g %g) native=%d\n", b.value(), balls_.NumVertices(b),
-            balls_.Radius(b), balls_.Center(b).x, balls_.Center(b).y, balls_.Center(b).z, p.value(), points_.CdOf(p).dim, points_.Parent(p).value(), q.x, q.y, q.z, (int)facts.native);
-  }
   if (r.encroach == EncroachOutcome::kEnqueue) EnqueueEncroached(b);
   if (r.encroach == EncroachOutcome::kPartial) partial_.push_back(b);
 }
@@ -592,9 +602,6 @@ void Refiner::RefreshEvents(VertexId v, const CellSize* size) {
     queues_.Remove(u);
   }
   // Skinny: R_v/r_v > τ (Figure 3.5), gap ball at the farthest corner.
-  if (getenv("SVRC_WATCH") && v.value() == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
-    fprintf(stderr, "WATCH refresh v=%u gen=%u R=%g r=%g skinny=%d given=%d\n", v.value(), gen, s.outradius, s.inradius, (int)IsSkinny(s), size != nullptr);
-  }
   EventHandle& k = omega_.SkinnyEvent(v);
   if (IsSkinny(s)) {
     if (queues_.IsQueued(k)) {
@@ -702,26 +709,9 @@ absl::Status Refiner::Run() {
         if (!s.ok()) return s;
       }
       if (options_.progress) options_.progress(TotalVertices(), queues_.size(), event->radius);
-      if (getenv("SVRC_DEBUG")) {
-        const WorkQueues::Stats& q = queues_.stats();
-        fprintf(stderr, "DBG omega=%u seg=%lu facet=%lu warps=%lu yields=%lu pushed s/e/u=%lu/%lu/%lu ev type=%d dim=%d mesh=%u\n",
-                omega_.NumVertices(), (unsigned long)stats_.segment_vertices, (unsigned long)stats_.facet_vertices,
-                (unsigned long)stats_.warps, (unsigned long)stats_.yields, (unsigned long)q.pushed[0],
-                (unsigned long)q.pushed[1], (unsigned long)q.pushed[2], (int)event->type, (int)event->dim, event->mesh.value());
-      }
     }
     ++destroys;
-    if (getenv("SVRC_DEBUG") && event->radius < atof(getenv("SVRC_DEBUG"))) {
-      fprintf(stderr, "SMALL ev type=%d dim=%d mesh=%u obj=%u r=%g c=(%g %g %g) omega=%u\n", (int)event->type, (int)event->dim,
-              event->mesh.value(), event->object, event->radius, event->center.x, event->center.y, event->center.z, omega_.NumVertices());
-    }
-    if (getenv("SVRC_WATCH") && event->mesh == kOmegaMesh && event->object == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
-      fprintf(stderr, "WATCH destroy type=%d gen=%u r=%g ins=%lu\n", (int)event->type, event->generation, event->radius, (unsigned long)stats_.insertions);
-    }
     absl::Status s = Destroy(*event);
-    if (getenv("SVRC_WATCH") && event->mesh == kOmegaMesh && event->object == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
-      fprintf(stderr, "WATCH after gen=%u ins=%lu\n", omega_.CellGeneration(VertexId(event->object)), (unsigned long)stats_.insertions);
-    }
     if (!s.ok()) return s;
     if (options_.validate_every > 0 && destroys % options_.validate_every == 0) {
       s = CheckInvariants(false);
@@ -859,12 +849,6 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
         }
       }
     }
-    if (getenv("SVRC_DEBUG3") && tri.valid()) {
-      const auto& dt = m.dt();
-      fprintf(stderr, "TRI f=%u c=(%g %g) r=%g warp=%d yield=%d cells=%zu in_facet=%d verts:", f, c.x, c.y, r, warp.valid(), yield.valid(), bfs2_.size(), (int)m.InFacet(tri));
-      for (int k = 0; k < 3; ++k) { Vec2 q = dt.Point(dt.TriVertex(tri, k)); fprintf(stderr, " (%g %g | %d)", q.x, q.y, (int)m.region().Locate(q)); }
-      fprintf(stderr, "\n");
-    }
     if (warp.valid()) {
       ++stats_.warps;
       const PointId p = balls_.VertexPoint(warp);
@@ -877,8 +861,13 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
       if (!(c.x >= m.SquareLo().x && c.x <= m.SquareHi().x && c.y >= m.SquareLo().y && c.y <= m.SquareHi().y)) {
         return absl::InternalError(absl::StrCat("SVRC: facet ", f, " gap ball centre (", c.x, ", ", c.y, ") r=", r, " outside its square Ω_F [", m.SquareLo().x, ",", m.SquareHi().x, "]x[", m.SquareLo().y, ",", m.SquareHi().y, "]"));
       }
-      const PointId p = points_.Add(frames_[f].ToSpace(c), features_.OfFacet(f), kCdFacet);
-      return ForceInsertFacet(f, p, c, hint);
+      const uint64_t id = points_.size();
+      Vec2 cj{c.x + kJitter * r * Jitter(id, 1), c.y + kJitter * r * Jitter(id, 2)};
+      if (!(cj.x >= m.SquareLo().x && cj.x <= m.SquareHi().x && cj.y >= m.SquareLo().y && cj.y <= m.SquareHi().y)) {
+        cj = c;  // a corner on ∂Ω_F stays on it
+      }
+      const PointId p = points_.Add(frames_[f].ToSpace(cj), features_.OfFacet(f), kCdFacet);
+      return ForceInsertFacet(f, p, cj, hint);
     }
     ++stats_.yields;
     absl::Status st = DestroySegmentPiece(piece_seg_[yield.value()], piece_vertex_[yield.value()]);
@@ -893,7 +882,8 @@ absl::Status Refiner::DestroySegmentPiece(uint32_t seg, uint32_t u) {
   // M_s from the start, so 𝒲 = 𝒴 = ∅ until collar points (1,2) exist
   // (stage (d)). Line 11: insert the centre.
   SegmentMesh& m = segs_[seg];
-  const double t = 0.5 * (m.T(u) + m.T(m.Next(u)));
+  const double t = 0.5 * (m.T(u) + m.T(m.Next(u))) +
+                   0.5 * kJitter * (m.T(m.Next(u)) - m.T(u)) * Jitter(points_.size(), 3);
   if (!(t > m.T(u) && t < m.T(m.Next(u)))) {
     return absl::InternalError(absl::StrCat("SVRC: segment ", seg, " piece too short to split (t = ", t, ")"));
   }
@@ -962,22 +952,6 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
     }
     if (warp.valid()) {
       ++stats_.warps;
-      if (getenv("SVRC_WATCH") && v.value() == (uint32_t)atoi(getenv("SVRC_WATCH"))) {
-        const Vec3 q = points_.Xyz(balls_.VertexPoint(warp));
-        fprintf(stderr, "WATCH warp to point %u cd=%s q=(%.17g %.17g %.17g) c=(%.17g %.17g %.17g) d=%g r=%g\n", balls_.VertexPoint(warp).value(),
-                CdToString(balls_.CdOf(warp)).c_str(), q.x, q.y, q.z, c.x, c.y, c.z, std::sqrt(warp_d2), r);
-        std::vector<TetId> st;
-        omega_.dt().Star(v, &st);
-        for (TetId t : st) {
-          if (omega_.dt().IsGhost(t)) { fprintf(stderr, "  ghost\n"); continue; }
-          const Vec3 cc = omega_.dt().Circumcenter(t);
-          bool has = false;
-          for (int k = 0; k < 4; ++k) has = has || omega_.dt().TetVertex(t, k) == v;
-          if (!has || !omega_.dt().IsAlive(t)) fprintf(stderr, "  STALE tet %u alive=%d has=%d\n", t.value(), (int)omega_.dt().IsAlive(t), (int)has);
-          fprintf(stderr, "  tet %u cc=(%g %g %g) R=%g |cc-c|=%g |q-cc|=%g\n", t.value(), cc.x, cc.y, cc.z,
-                  geom::Dist(cc, omega_.dt().Point(v)), geom::Dist(cc, c), geom::Dist(q, cc));
-        }
-      }
       std::vector<uint32_t> cells;
       blg_.CellsOf(LocationObject::Ball(warp), kOmegaMesh, &cells);
       const TetId hint = cells.empty() ? s.hint : omega_.dt().VertexTet(VertexId(cells[0]));
@@ -992,7 +966,6 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
       const VertexId near = omega_.dt().NearestVertex(c, s.hint);
       if (omega_.dt().Point(near) == c) {
         ++stats_.phantom_corners;
-        if (getenv("SVRC_DEBUG")) fprintf(stderr, "PHANTOM cell %u at (%g %g %g)\n", v.value(), c.x, c.y, c.z);
         return absl::OkStatus();
       }
       return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), kCdSpace), s.hint);
@@ -1032,13 +1005,6 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // scratch, which later queries reuse.
   std::vector<VertexId> changed(result.cavity_vertices.begin(), result.cavity_vertices.end());
   changed.push_back(nv);
-  if (getenv("SVRC_WATCH")) {
-    const uint32_t w = atoi(getenv("SVRC_WATCH"));
-    bool in = false;
-    for (VertexId u : changed) in = in || u.value() == w;
-    if (p.value() == 828) fprintf(stderr, "WATCH validate: %s\n", dt.Validate(true).ToString().c_str());
-    if (p.value() == 828) fprintf(stderr, "WATCH insert p=%u nv=%u changed=%zu has_watch=%d created=%zu destroyed=%zu\n", p.value(), nv.value(), changed.size(), (int)in, result.created.size(), result.destroyed.size());
-  }
   for (VertexId u : changed) omega_.BumpCell(u);
   std::vector<CellSize> sizes(changed.size());
   for (size_t i = 0; i < changed.size(); ++i) sizes[i] = omega_.Size(changed[i]);
@@ -1162,6 +1128,14 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
   if (steiner) ++stats_.facet_vertices;
   const VertexId2 nv = r.vertex;
   points_.SetVertex(p, mesh, nv.value());
+  // A segment point: tell M_F which of its segments it lies on (InFacet).
+  if (features_.Dim(points_.Parent(p)) == 1) {
+    const uint32_t seg = features_.Index(points_.Parent(p));
+    const auto& ids = m.region().segment_ids;
+    for (size_t k = 0; k < ids.size(); ++k) {
+      if (ids[k] == seg) m.SetOnSegment(nv, static_cast<int32_t>(k));
+    }
+  }
   // Copies: the spans point into Delaunay2 scratch.
   std::vector<VertexId2> changed(r.cavity_vertices.begin(), r.cavity_vertices.end());
   changed.push_back(nv);

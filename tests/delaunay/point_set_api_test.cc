@@ -1,8 +1,9 @@
 // core::MeshPlc on point sets (issue #2): the Delaunay tetrahedralization in
 // canonical order with stats, progress and cancellation; PLCs with facets stay
-// UNIMPLEMENTED (never a convex-hull mesh).
+// refused (never a convex-hull mesh).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <random>
 
 #include "core/api.h"
@@ -92,14 +93,28 @@ TEST(MeshPlcPointSetTest, ProgressAndCancel) {
   EXPECT_EQ(c.status().code(), absl::StatusCode::kCancelled);
 }
 
-TEST(MeshPlcPointSetTest, PlcWithFacetsStaysUnimplemented) {
-  plc::Plc p = RandomPointSet(8, 3);
-  plc::Facet f;
-  f.polygons.push_back(plc::Polygon{{0, 1, 2}});
-  p.facets.push_back(f);
+// A PLC with facets goes to SVRC refinement, never to the point-set path. A
+// regular-ish tetrahedron's facets meet at ~70.5°: creases, which need
+// collars (issue #6), so it is refused up front with FAILED_PRECONDITION
+// naming the crease; a lone triangle encloses no volume: INVALID_ARGUMENT.
+TEST(MeshPlcPointSetTest, PlcWithCreasesIsRefusedNamingTheCrease) {
+  plc::Plc p;
+  p.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 0.8}};
+  for (std::array<uint32_t, 3> t : {std::array<uint32_t, 3>{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}}) {
+    plc::Facet f;
+    f.polygons.push_back(plc::Polygon{{t[0], t[1], t[2]}});
+    p.facets.push_back(f);
+  }
   auto m = MeshPlc(p, MeshParams{});
   ASSERT_FALSE(m.ok());
-  EXPECT_EQ(m.status().code(), absl::StatusCode::kUnimplemented);
+  EXPECT_EQ(m.status().code(), absl::StatusCode::kFailedPrecondition) << m.status();
+  EXPECT_NE(m.status().message().find("crease"), std::string::npos) << m.status();
+
+  plc::Plc lone = RandomPointSet(8, 3);
+  plc::Facet f;
+  f.polygons.push_back(plc::Polygon{{0, 1, 2}});
+  lone.facets.push_back(f);
+  EXPECT_EQ(MeshPlc(lone, MeshParams{}).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -196,6 +196,11 @@ bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double face
     const auto vid = delaunay::Delaunay2::VertexId(v);
     const CellSize2 s = mesh.Size(vid);
     EXPECT_TRUE(std::isfinite(s.outradius));
+    if (dt.IsCorner(vid) && s.outradius == 0) {
+      // A quadrilateral corner whose cell no longer meets Ω_F.
+      EXPECT_TRUE(s.clipped);
+      continue;
+    }
     EXPECT_LE(s.inradius, s.outradius + 1e-15);
     EXPECT_GE(s.corner.x, lo.x);
     EXPECT_LE(s.corner.x, hi.x);
@@ -250,17 +255,22 @@ TEST(FacetMeshTest, CornerCellOfSquareWithOnePoint) {
   const double half = 1.5 * std::sqrt(2.0);
   EXPECT_DOUBLE_EQ(mesh.SquareLo().x, 0.5 - half);
   EXPECT_DOUBLE_EQ(mesh.SquareHi().y, 0.5 + half);
+  // The Delaunay quadrilateral is the square of 3× Ω_F's side around it.
+  EXPECT_DOUBLE_EQ(mesh.QuadCorner(0).x, 0.5 - 3 * half);
+  EXPECT_DOUBLE_EQ(mesh.QuadCorner(2).y, 0.5 + 3 * half);
   mesh.Insert({0.5, 0.5}, PointId(20));
-  // The centre point's cell is the diamond of the square's corners' bisectors:
-  // its farthest corner is a midpoint of a side of Ω_F, at distance half.
+  // The centre point's cell is the diamond of the quadrilateral corners'
+  // bisectors (at 1.5·√2·half along the diagonals), which contains Ω_F: its
+  // farthest corner is a corner of Ω_F, at √2·half; r_v is half the distance
+  // to a quadrilateral corner.
   const CellSize2 s = mesh.Size(delaunay::Delaunay2::VertexId(4));
-  EXPECT_NEAR(s.outradius, half, 1e-12);
-  EXPECT_NEAR(s.inradius, 0.5 * std::sqrt(2.0) * half, 1e-12);
-  // A corner's cell (clipped): the triangle of the square corner and the two
-  // side midpoints next to it; the farthest corner is a midpoint, at `half`.
+  EXPECT_TRUE(s.clipped);
+  EXPECT_NEAR(s.outradius, std::sqrt(2.0) * half, 1e-12);
+  EXPECT_NEAR(s.inradius, 1.5 * std::sqrt(2.0) * half, 1e-12);
+  // A quadrilateral corner's cell does not meet Ω_F: R = 0, never skinny.
   const CellSize2 c = mesh.Size(delaunay::Delaunay2::VertexId(0));
   EXPECT_TRUE(c.clipped);
-  EXPECT_NEAR(c.outradius, half, 1e-12);
+  EXPECT_EQ(c.outradius, 0.0);
 }
 
 // Corpus facets: cube (convex quads), box_internal_facet (an internal facet),

@@ -143,7 +143,19 @@ TEST(SegmentsTest, CloseParallelSegmentsAndObtuseCorner) {
   auto r = RefinePointsAndSegments(pts, segs, Checked(211));
   ASSERT_TRUE(r.ok()) << r.status();
   ExpectConformingSegments(pts, segs, *r, 4.0);
-  EXPECT_GE(r->segment_chains[1].size(), 10u);
+  // The middle segment is refined to its local feature size: no vertex of
+  // the two neighbouring segments (0.05 away) lies inside the diametral ball
+  // of one of its pieces (so pieces are at most ~0.13 long: ≥ 8 of them).
+  const auto& mid = r->segment_chains[1];
+  EXPECT_GE(mid.size(), 9u);
+  for (size_t i = 0; i + 1 < mid.size(); ++i) {
+    const Vec3 a = r->positions[mid[i]], b = r->positions[mid[i + 1]];
+    for (int other : {0, 2}) {
+      for (uint32_t q : r->segment_chains[other]) {
+        EXPECT_LE(geom::InDiametralSphere(a, b, r->positions[q]), 0) << "piece " << i << " vertex " << q;
+      }
+    }
+  }
 }
 
 TEST(SegmentsTest, DeterministicAndRejectsBadSegments) {
