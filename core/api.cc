@@ -109,11 +109,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     return absl::InvalidArgumentError("radius_edge must be a positive number");
   }
   if (!(params.theta > 0 && params.theta < 1)) return absl::InvalidArgumentError("theta must be in (0, 1)");
-  // Not built yet: refuse rather than ignore (issue #5 size events, thesis
-  // §6.2.1 sliver removal).
-  if (params.max_volume > 0) {
-    return absl::UnimplementedError("max_volume: size-driven refinement is not implemented yet for PLCs");
-  }
+  // Not built yet: refuse rather than ignore (thesis §6.2.1 sliver removal).
   if (params.min_dihedral > 0) {
     return absl::UnimplementedError("min_dihedral: sliver removal is not implemented yet");
   }
@@ -128,6 +124,10 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   options.tau = 2.0 * params.radius_edge;
   options.theta = params.theta;
   options.max_vertices = params.max_vertices;
+  options.max_volume = params.max_volume;
+  // A PLC without facets encloses nothing: its output is the whole Ω mesh.
+  const bool keep_box = params.keep_bounding_box || complex->facets.empty();
+  options.keep_bounding_box = keep_box;
   if (cancel != nullptr || progress) {
     options.poll = [&]() -> absl::Status {
       if (cancel != nullptr) {
@@ -164,7 +164,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   map.exponent = refined->normalisation_exponent;
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex, faces, map,
-                              params.keep_bounding_box, &stats);
+                              keep_box, &stats);
   if (!out.ok()) return out.status();
   if (out->report.num_nonpositive_tets != 0) {
     return absl::InternalError(absl::StrCat("SVRC: ", out->report.num_nonpositive_tets,

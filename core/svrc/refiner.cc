@@ -16,6 +16,7 @@
 #include "core/svrc/containment.h"
 #include "core/svrc/facet_mesh.h"
 #include "core/svrc/feature_meshes.h"
+#include "core/svrc/labelling.h"
 #include "core/svrc/location_graph.h"
 #include "core/svrc/normalize.h"
 #include "core/svrc/points.h"
@@ -82,6 +83,21 @@ class Refiner {
   // segment piece is an edge and every in-facet triangle a face of M_Ω, all
   // their vertices in M_Ω. INTERNAL naming the first failure.
   absl::Status VerifyConformity() const;
+ public:
+  // max_volume (issue #5 "size events"): labels the regions of the current,
+  // conforming M_Ω (flood fill across faces that are not in-facet triangles,
+  // seeds and holes of the complex), and gives every vertex of a kept tet the
+  // size target R_t = the circumradius of a regular tet of its region's
+  // volume bound (the smallest bound of its tets; `global_max_volume` in
+  // input units applies to every kept region; ≤ 0: none). A cell with
+  // R_v ≤ R_t has incident tets of circumradius ≤ R_t, hence volume ≤ the
+  // bound (the regular tet has the largest volume for its circumradius).
+  // Vertices created later get no target until the next call (inheriting one
+  // leaked targets across facets into the exterior: measured, the whole Ω
+  // refined to max_volume); a τ-well-spaced neighbour of a small cell is small.
+  // Enqueues the cells above target; returns whether any was.
+  absl::StatusOr<bool> SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume);
+ private:
   // The sorted point-id faces and edges of M_Ω's finite tets.
   void OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces, std::vector<std::array<uint32_t, 2>>* edges) const;
   // End of the queues: a piece that is not an edge of M_Ω or of a facet mesh
@@ -160,6 +176,10 @@ class Refiner {
   void RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size = nullptr);
   bool IsLive(const WorkEvent& event);
   bool IsSkinny(const CellSize& s) const { return s.outradius > options_.tau * s.inradius; }
+  // Skinny, or larger than the size target of max_volume (SetSizeTargets).
+  bool IsBad(VertexId v, const CellSize& s) const {
+    return IsSkinny(s) || (v.value() < size_target_.size() && s.outradius > size_target_[v.value()]);
+  }
   bool IsSkinny(const SegmentMesh::Size1& s) const { return s.outradius > options_.tau * s.inradius; }
   bool IsSkinny(const CellSize2& s) const { return s.outradius > options_.tau * s.inradius; }
 
@@ -217,6 +237,7 @@ class Refiner {
   uint32_t stamp2_ = 0;
   // Balls that got a first, non-native encroacher (PartiallyEncroached).
   std::vector<BallId> partial_;
+  std::vector<double> size_target_;  // per M_Ω vertex: max R_v from max_volume (+inf: none)
   RefineStats stats_;
   uint64_t budget_ = 0;
   // The cell size IsLive computed for the event Destroy gets next.
@@ -601,9 +622,10 @@ void Refiner::RefreshEvents(VertexId v, const CellSize* size) {
   } else if (queues_.IsQueued(u)) {
     queues_.Remove(u);
   }
-  // Skinny: R_v/r_v > τ (Figure 3.5), gap ball at the farthest corner.
+  // Skinny: R_v/r_v > τ (Figure 3.5), or a size event (R_v above the cell's
+  // max_volume target); gap ball at the farthest corner.
   EventHandle& k = omega_.SkinnyEvent(v);
-  if (IsSkinny(s)) {
+  if (IsBad(v, s)) {
     if (queues_.IsQueued(k)) {
       queues_.Refresh(k, gen, s.corner, s.outradius);
     } else {
@@ -688,7 +710,7 @@ bool Refiner::IsLive(const WorkEvent& e) {
   last_size_ = omega_.Size(v);
   last_size_vertex_ = v;
   last_size_gen_ = omega_.CellGeneration(v);
-  if (e.type == EventType::kSkinny) return IsSkinny(last_size_);
+  if (e.type == EventType::kSkinny) return IsBad(v, last_size_);
   return true;
 }
 
@@ -1006,6 +1028,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   std::vector<VertexId> changed(result.cavity_vertices.begin(), result.cavity_vertices.end());
   changed.push_back(nv);
   for (VertexId u : changed) omega_.BumpCell(u);
+
   std::vector<CellSize> sizes(changed.size());
   for (size_t i = 0; i < changed.size(); ++i) sizes[i] = omega_.Size(changed[i]);
   // UpdateLocation (3.6) for F = Ω: no new ConfBalls; re-intersect the lower
@@ -1245,7 +1268,7 @@ absl::Status Refiner::CheckInvariants(bool final) {
   for (uint32_t w = 0; w < dt.NumVertices(); ++w) {
     const VertexId v(w);
     const CellSize cs = omega_.Size(v);
-    if (!IsSkinny(cs)) continue;
+    if (!IsBad(v, cs)) continue;
     if (final && dt.Point(dt.NearestVertex(cs.corner, cs.hint)) != cs.corner) {
       return absl::InternalError(absl::StrCat("SVRC invariant: cell ", w, " skinny at the end: R/r = ",
                                               cs.outradius / cs.inradius));
@@ -1321,6 +1344,71 @@ void Refiner::OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces_out,
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+}
+
+absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume) {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  const uint32_t nv = dt.NumVertices();
+  std::vector<Vec3> positions(nv);
+  for (uint32_t v = 0; v < nv; ++v) positions[v] = dt.Point(VertexId(v));
+  std::vector<std::array<uint32_t, 4>> tets;
+  for (TetId t : dt.FiniteTets()) {
+    tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
+                    dt.TetVertex(t, 3).value()});
+  }
+  std::vector<ConstrainedFace> faces;
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    for (const auto& tri : facets_[f].InFacetTriangles()) {
+      ConstrainedFace cf;
+      for (int k = 0; k < 3; ++k) cf.v[k] = points_.VertexIn(tri[k], kOmegaMesh);
+      cf.facet = f;
+      faces.push_back(cf);
+    }
+  }
+  std::vector<plc::RegionSeed> seeds = complex.regions;
+  for (plc::RegionSeed& sd : seeds) sd.point = norm_.Forward(sd.point);
+  std::vector<Vec3> holes;
+  for (const Vec3& h : complex.holes) holes.push_back(norm_.Forward(h));
+  LabelInput in;
+  in.positions = positions;
+  in.tets = tets;
+  in.constrained_faces = faces;
+  in.region_seeds = seeds;
+  in.hole_seeds = holes;
+  in.keep_bounding_box = options_.keep_bounding_box || facets_.empty();
+  absl::StatusOr<Labelling> lab = LabelRegions(in);
+  if (!lab.ok()) return lab.status();
+  // Volumes scale by 2^−3e into normalised coordinates (exact).
+  const double scale3 = std::ldexp(1.0, -3 * norm_.exponent);
+  if (size_target_.size() < nv) size_target_.resize(nv, HUGE_VAL);
+  std::vector<uint8_t> touched(nv, 0);
+  for (size_t t = 0; t < tets.size(); ++t) {
+    if (!lab->Kept(static_cast<uint32_t>(t))) continue;
+    double vmax = HUGE_VAL;
+    const double region = lab->components[lab->tet_component[t]].max_volume;
+    if (region > 0) vmax = region;
+    if (global_max_volume > 0) vmax = std::min(vmax, global_max_volume);
+    if (vmax == HUGE_VAL) continue;
+    // Regular tet of volume V: edge a = (6√2·V)^(1/3), circumradius a·√6/4.
+    const double a = std::cbrt(6.0 * std::sqrt(2.0) * vmax * scale3);
+    const double rt = a * std::sqrt(6.0) / 4.0;
+    for (uint32_t v : tets[t]) {
+      if (rt < size_target_[v]) {
+        size_target_[v] = rt;
+        touched[v] = 1;
+      }
+    }
+  }
+  bool any = false;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (!touched[v]) continue;
+    const CellSize cs = omega_.Size(VertexId(v));
+    if (IsBad(VertexId(v), cs)) {
+      RefreshEvents(VertexId(v), &cs);
+      any = true;
+    }
+  }
+  return any;
 }
 
 bool Refiner::EnqueueMissing() {
@@ -1569,6 +1657,18 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   if (!s.ok()) return s;
   s = refiner.Run();
   if (!s.ok()) return s;
+  // Size events (max_volume): label the conforming mesh, enqueue the cells
+  // above their region's target, refine again; targets carry over to new
+  // vertices, so a round converges and a few rounds settle region borders.
+  bool any_volume = options.max_volume > 0;
+  for (const plc::RegionSeed& sd : complex.regions) any_volume = any_volume || sd.max_volume > 0;
+  for (int round = 0; any_volume && round < 64; ++round) {
+    absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
+    if (!more.ok()) return more.status();
+    if (!*more) break;
+    s = refiner.Run();
+    if (!s.ok()) return s;
+  }
   if (options.validate_every > 0) {
     s = refiner.CheckInvariants(/*final=*/true);
     if (!s.ok()) return s;

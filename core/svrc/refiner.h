@@ -34,6 +34,12 @@ struct RefineOptions {
   // status aborts the run and is returned. May be null.
   std::function<absl::Status()> poll;
   uint32_t poll_interval = 256;
+  // RefinePlc: global max tet volume in input units (≤ 0: none); region seeds'
+  // max volumes apply too (size events).
+  double max_volume = 0;
+  // Size events apply to the whole Ω mesh (MeshParams::keep_bounding_box; a
+  // PLC without facets has no inside, so its whole Ω mesh is output too).
+  bool keep_bounding_box = false;
   // Called at every poll: vertices in all meshes, pending events, radius of
   // the event about to be destroyed (the largest work radius). May be null.
   std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;

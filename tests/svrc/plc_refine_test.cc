@@ -5,7 +5,10 @@
 
 #include "core/api.h"
 #include "core/mesh/conformity.h"
+#include "core/codec/container.h"
+#include "core/geometry/predicates.h"
 #include "core/mesh/quality.h"
+#include "core/plc/families.h"
 #include "core/plc/readers.h"
 #include "gtest/gtest.h"
 #include "tests/test_support.h"
@@ -63,6 +66,82 @@ TEST(PlcRefine, TinyCubeInBox) {
 TEST(PlcRefine, FarOffsetClosePoints) {
   Meshed m = MeshCorpus("e_spread/far_offset_close_points.poly");
   ExpectGoodMesh(m, 2.0, "far_offset_close_points");
+}
+
+// Six times the signed volume of tet t (input coordinates).
+double Volume6(const mesh::TetMesh& m, size_t t) {
+  const auto& v = m.tets[t];
+  const geom::Vec3 a = m.positions[v[0]];
+  return geom::Dot(m.positions[v[1]] - a, geom::Cross(m.positions[v[2]] - a, m.positions[v[3]] - a));
+}
+
+// Every generated family without creases (core/plc/families.h): boxes with
+// internal facets, a hole, a cavity, a tunnel (facets with holes), an
+// internal facet with a polygonal hole, free segments and isolated points,
+// nested regions, skew lines.
+TEST(PlcRefine, GeneratedFamiliesWithoutCreases) {
+  int meshed = 0;
+  for (const plc::families::GeneratedInput& in : plc::families::StandardInputs()) {
+    if (in.crease_angle_deg > 0 || in.plc.IsPointSet()) continue;
+    core::MeshParams params;
+    params.max_volume = in.max_volume;
+    absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(in.plc, params);
+    ASSERT_TRUE(m.ok()) << in.name << ": " << m.status();
+    Meshed mm{in.plc, std::move(*m)};
+    ExpectGoodMesh(mm, 2.0, in.name);
+    ++meshed;
+  }
+  EXPECT_GE(meshed, 10);
+}
+
+// max_volume, global and per region (size events): every tet of a region
+// within its bound, regions keep their attributes, output still conforming.
+TEST(PlcRefine, MaxVolumeGlobalAndPerRegion) {
+  {
+    plc::Plc cube = plc::families::VolumeConstrainedCube(1.0, 0);
+    core::MeshParams params;
+    params.max_volume = 1e-3;
+    absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(cube, params);
+    ASSERT_TRUE(m.ok()) << m.status();
+    Meshed mm{cube, std::move(*m)};
+    ExpectGoodMesh(mm, 2.0, "cube max_volume 1e-3");
+    double worst = 0;
+    for (size_t t = 0; t < mm.mesh.tets.size(); ++t) worst = std::max(worst, Volume6(mm.mesh, t) / 6);
+    EXPECT_LE(worst, 1e-3);
+    EXPECT_GE(mm.mesh.tets.size(), 1000u);  // 1/1e-3 tets at least
+  }
+  {
+    plc::Plc nested = plc::families::NestedBoxes(3, 1e-2, 1.0 / 8);
+    absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(nested, {});
+    ASSERT_TRUE(m.ok()) << m.status();
+    Meshed mm{nested, std::move(*m)};
+    ExpectGoodMesh(mm, 2.0, "nested boxes");
+    ASSERT_EQ(mm.mesh.regions.size(), 3u);
+    for (size_t t = 0; t < mm.mesh.tets.size(); ++t) {
+      const auto& region = mm.mesh.regions[mm.mesh.tet_region[t]];
+      ASSERT_GT(region.max_volume, 0);
+      EXPECT_LE(Volume6(mm.mesh, t) / 6, region.max_volume) << "tet " << t;
+    }
+  }
+}
+
+// Same input and parameters, same output bytes (the container encodes every
+// array; the provenance has no time stamp).
+TEST(PlcRefine, Deterministic) {
+  const plc::Plc in = plc::families::BoxWithInternalFacets(3);
+  std::string first;
+  for (int run = 0; run < 2; ++run) {
+    absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(in, {});
+    ASSERT_TRUE(m.ok()) << m.status();
+    m->stats = {};  // timings differ
+    absl::StatusOr<std::string> bytes = codec::EncodeTetMesh(*m, {});
+    ASSERT_TRUE(bytes.ok()) << bytes.status();
+    if (run == 0) {
+      first = *bytes;
+    } else {
+      EXPECT_TRUE(first == *bytes) << "two runs gave different bytes";
+    }
+  }
 }
 
 }  // namespace
