@@ -1,0 +1,542 @@
+// Output-sensitive cost of SVRC on PLCs (issue #5 "Must show"; thesis ch. 5
+// and §1.5.1): series of runs of the PLC pipeline of core::MeshPlc
+// (plc::PreparePlc → refine::RefinePlc → refine::BuildOutputMesh) in-process,
+// each run in a fresh child process (this binary re-executed with --one) so
+// that its peak RSS is its own. Per run: output tets, wall and CPU time per
+// output tet, "Voronoi cells plus location-graph links touched per insertion"
+// = (RefineStats::destroy_cells_visited + links_added + links_removed) /
+// insertions, peak RSS bytes per output tet; per series whether each stays
+// within 1.5× over the runs with ≥ 10^4 output tets (the issue's criterion).
+//
+// Series (default: all four, default parameters):
+//   cube     families::VolumeConstrainedCube(1, V), V in --cube-volumes
+//   skew     families::SkewLines(n) (segments, unit box), n in --skew-n
+//   skewvol  the same with a global max volume --skewvol-volume, n in --skewvol-n
+//   spread   families::BoxWithCavity(10^-k) (a closed cube of side 10^-k, its
+//            own region, centred in the unit box: spread Δ ≈ 10^k), k in --spread-k
+//   file:PATH  one corpus file (e.g. e_spread/tiny_cube_in_box.poly)
+// Flags: --radius-edge B (default 2: τ = 2B), --timeout S per run (default
+// 600), --mem-limit-mib M (RLIMIT_AS per child, default 8192), --verify (each
+// child also runs core::MeshPlc and checks that it gives the same mesh, bit
+// for bit: the bench measures what the product does).
+// Internal: --one cube V | skew n V | spread k | file PATH  (one run, prints
+// one "RESULT key=value ..." line).
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/time.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "core/api.h"
+#include "core/mesh/quality.h"
+#include "core/plc/families.h"
+#include "core/plc/readers.h"
+#include "core/plc/validate.h"
+#include "core/svrc/assemble.h"
+#include "core/svrc/refiner.h"
+
+namespace svrc::bench {
+namespace {
+
+// ---------------------------------------------------------------- child
+
+double CpuNow() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+double WallNow() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Resident set size now, KiB (/proc/self/status VmRSS).
+long RssKib() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
+  }
+  return 0;
+}
+long PeakRssKib() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_maxrss;
+}
+
+bool SameMesh(const mesh::TetMesh& a, const mesh::TetMesh& b) {
+  if (a.positions.size() != b.positions.size() || a.tets != b.tets || a.tet_region != b.tet_region) {
+    return false;
+  }
+  for (size_t i = 0; i < a.positions.size(); ++i) {
+    if (std::memcmp(&a.positions[i], &b.positions[i], sizeof(geom::Vec3)) != 0) return false;
+  }
+  return true;
+}
+
+// One run in this process; prints "RESULT key=value ..." (or "RESULT
+// status=... message=..." on failure) to stdout.
+int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify) {
+  const long base_kib = RssKib();
+  plc::Plc plc;
+  double max_volume = 0;
+  const std::string kind = args.empty() ? "" : args[0];
+  auto num = [&](size_t i) { return i < args.size() ? std::atof(args[i].c_str()) : 0.0; };
+  if (kind == "cube") {
+    plc = plc::families::VolumeConstrainedCube(1, num(1));
+  } else if (kind == "skew") {
+    plc = plc::families::SkewLines(static_cast<int>(num(1)));
+    max_volume = num(2);
+  } else if (kind == "spread") {
+    plc = plc::families::BoxWithCavity(std::pow(10.0, -num(1)));
+  } else if (kind == "file" && args.size() > 1) {
+    absl::StatusOr<plc::Plc> p = plc::ReadPlcFile(args[1]);
+    if (!p.ok()) {
+      std::printf("RESULT status=%s\n", std::string(absl::StatusCodeToString(p.status().code())).c_str());
+      return 1;
+    }
+    plc = *std::move(p);
+  } else {
+    std::fprintf(stderr, "--one: unknown case\n");
+    return 2;
+  }
+
+  // The pipeline of core::MeshPlc's PLC branch (core/api.cc), timed per phase.
+  const double w0 = WallNow(), c0 = CpuNow();
+  plc::ValidationReport vreport;
+  absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(plc, {}, {}, &vreport);
+  if (!complex.ok()) {
+    std::printf("RESULT status=%s\n", std::string(absl::StatusCodeToString(complex.status().code())).c_str());
+    std::fprintf(stderr, "%s\n", complex.status().ToString().c_str());
+    return 1;
+  }
+  const double w1 = WallNow(), c1 = CpuNow();
+  refine::RefineOptions options;
+  options.tau = 2.0 * radius_edge;
+  options.max_volume = max_volume;
+  const bool keep_box = complex->facets.empty();
+  options.keep_bounding_box = keep_box;
+  absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
+  if (!refined.ok()) {
+    std::printf("RESULT status=%s\n", std::string(absl::StatusCodeToString(refined.status().code())).c_str());
+    std::fprintf(stderr, "%s\n", refined.status().ToString().c_str());
+    return 1;
+  }
+  const double w2 = WallNow(), c2 = CpuNow();
+  std::vector<refine::ConstrainedFace> faces;
+  for (uint32_t f = 0; f < refined->facet_triangles.size(); ++f) {
+    for (const auto& t : refined->facet_triangles[f]) {
+      refine::ConstrainedFace cf;
+      cf.v = t;
+      cf.marker = complex->facets[f].marker;
+      cf.facet = complex->facets[f].input_facet;
+      faces.push_back(cf);
+    }
+  }
+  refine::CoordinateMap map;
+  map.translation = refined->normalisation_translation;
+  map.exponent = refined->normalisation_exponent;
+  absl::StatusOr<refine::OutputStageResult> out =
+      refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex,
+                              faces, map, keep_box, nullptr);
+  if (!out.ok()) {
+    std::printf("RESULT status=%s\n", std::string(absl::StatusCodeToString(out.status().code())).c_str());
+    std::fprintf(stderr, "%s\n", out.status().ToString().c_str());
+    return 1;
+  }
+  const double w3 = WallNow(), c3 = CpuNow();
+  const long peak_kib = PeakRssKib();  // before the measurements below allocate
+
+  const refine::RefineStats& s = refined->stats;
+  const mesh::TetMesh& m = out->mesh;
+  const mesh::QualityReport q = mesh::ComputeQuality(m);
+  std::string verified = "-";
+  if (verify) {
+    core::MeshParams params;
+    params.radius_edge = radius_edge;
+    params.max_volume = max_volume;
+    absl::StatusOr<mesh::TetMesh> via_api = core::MeshPlc(plc, params);
+    verified = via_api.ok() && SameMesh(*via_api, m) ? "same" : "DIFFERENT";
+  }
+  std::printf(
+      "RESULT status=OK out_vertices=%zu out_tets=%zu omega_vertices=%llu omega_tets=%zu "
+      "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu links_added=%llu "
+      "links_removed=%llu warps=%llu yields=%llu max_degree=%u "
+      "wall_prepare=%.6f wall_refine=%.6f wall_output=%.6f cpu_prepare=%.6f cpu_refine=%.6f cpu_output=%.6f "
+      "base_kib=%ld peak_kib=%ld max_re=%.6g min_dih=%.6g verify=%s\n",
+      m.positions.size(), m.tets.size(), (unsigned long long)s.vertices, refined->tets.size(),
+      (unsigned long long)s.segment_vertices, (unsigned long long)s.facet_vertices,
+      (unsigned long long)s.insertions, (unsigned long long)s.destroy_cells_visited,
+      (unsigned long long)s.links_added, (unsigned long long)s.links_removed, (unsigned long long)s.warps,
+      (unsigned long long)s.yields, s.max_degree, w1 - w0, w2 - w1, w3 - w2, c1 - c0, c2 - c1, c3 - c2,
+      base_kib, peak_kib, q.all.radius_edge.max, q.all.dihedral_deg.min, verified.c_str());
+  return 0;
+}
+
+// ---------------------------------------------------------------- parent
+
+volatile sig_atomic_t g_child = 0;
+
+void KillChildAndExit(int sig) {
+  if (g_child > 0) kill(g_child, SIGKILL);
+  signal(sig, SIG_DFL);
+  raise(sig);
+}
+
+struct RunResult {
+  std::string status;  // "OK", a status code name, "timeout", "signal N", "exit N"
+  std::map<std::string, std::string> kv;
+  double D(const std::string& k) const {
+    auto it = kv.find(k);
+    return it == kv.end() ? std::nan("") : std::atof(it->second.c_str());
+  }
+};
+
+// Re-executes this binary with `--one args...`, stdout through a pipe, a
+// timeout (SIGKILL) and RLIMIT_AS.
+RunResult Spawn(const std::vector<std::string>& one_args, double radius_edge, bool verify, double timeout_s,
+                uint64_t mem_limit_mib) {
+  RunResult r;
+  std::vector<std::string> argv = {"/proc/self/exe", "--radius-edge", absl::StrCat(radius_edge)};
+  if (verify) argv.push_back("--verify");
+  argv.push_back("--one");
+  for (const auto& a : one_args) argv.push_back(a);
+  std::vector<char*> cargv;
+  for (auto& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  int fd[2];
+  if (pipe(fd) != 0) {
+    r.status = "pipe failed";
+    return r;
+  }
+  std::fflush(stdout);
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) {
+    r.status = "fork failed";
+    return r;
+  }
+  if (pid == 0) {
+    close(fd[0]);
+    dup2(fd[1], 1);
+    close(fd[1]);
+    if (mem_limit_mib > 0) {
+      rlimit lim{mem_limit_mib << 20, mem_limit_mib << 20};
+      setrlimit(RLIMIT_AS, &lim);
+    }
+    execv(cargv[0], cargv.data());
+    _exit(127);
+  }
+  g_child = pid;
+  close(fd[1]);
+  fcntl(fd[0], F_SETFL, O_NONBLOCK);
+  std::string text;
+  char buf[4096];
+  int status = 0;
+  bool timed_out = false;
+  for (;;) {
+    for (;;) {
+      const ssize_t n = read(fd[0], buf, sizeof buf);
+      if (n <= 0) break;
+      text.append(buf, static_cast<size_t>(n));
+    }
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    if (w == pid) break;
+    if (w < 0 && errno != EINTR) break;
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout_s) {
+      timed_out = true;
+      kill(pid, SIGKILL);
+      while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (;;) {
+    const ssize_t n = read(fd[0], buf, sizeof buf);
+    if (n <= 0) break;
+    text.append(buf, static_cast<size_t>(n));
+  }
+  close(fd[0]);
+  g_child = 0;
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    if (line.rfind("RESULT ", 0) != 0) continue;
+    for (absl::string_view kv : absl::StrSplit(line.substr(7), ' ', absl::SkipEmpty())) {
+      const size_t eq = kv.find('=');
+      if (eq != absl::string_view::npos) r.kv[std::string(kv.substr(0, eq))] = std::string(kv.substr(eq + 1));
+    }
+  }
+  if (timed_out) {
+    r.status = absl::StrCat("timeout (", timeout_s, " s)");
+  } else if (WIFSIGNALED(status)) {
+    r.status = absl::StrCat("signal ", WTERMSIG(status));
+  } else if (r.kv.count("status")) {
+    r.status = r.kv["status"];
+  } else {
+    r.status = absl::StrCat("exit ", WEXITSTATUS(status));
+  }
+  return r;
+}
+
+std::string F(double v, int prec) {
+  if (std::isnan(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f", prec, v);
+  return b;
+}
+std::string G(double v) {
+  if (std::isnan(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+struct Row {
+  std::string series, param;
+  RunResult r;
+  double tets = 0, cpu = 0, wall = 0, touched = 0, peak_b = 0, alloc_b = 0;
+};
+
+void PrintHeader() {
+  std::printf(
+      "| series | parameter | result | output vertices | output tets | M_Ω vertices | insertions | wall s | "
+      "cpu s (prepare/refine/output) | cpu µs/tet | wall µs/tet | cells+links per insertion (cells, links) | "
+      "peak RSS MiB | peak B/tet | (peak − start) B/tet | max r/e | min dih | MeshPlc same |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+}
+
+Row Measure(const std::string& series, const std::string& param, const std::vector<std::string>& one_args,
+            double radius_edge, bool verify, double timeout_s, uint64_t mem_mib) {
+  Row row;
+  row.series = series;
+  row.param = param;
+  std::fprintf(stderr, "[sensitivity] %s %s ...\n", series.c_str(), param.c_str());
+  row.r = Spawn(one_args, radius_edge, verify, timeout_s, mem_mib);
+  const RunResult& r = row.r;
+  if (r.status != "OK") {
+    std::printf("| %s | %s | %s | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - |\n", series.c_str(),
+                param.c_str(), r.status.c_str());
+    std::fflush(stdout);
+    return row;
+  }
+  row.tets = r.D("out_tets");
+  row.cpu = r.D("cpu_prepare") + r.D("cpu_refine") + r.D("cpu_output");
+  row.wall = r.D("wall_prepare") + r.D("wall_refine") + r.D("wall_output");
+  const double ins = r.D("insertions");
+  const double cells = r.D("destroy_cells"), links = r.D("links_added") + r.D("links_removed");
+  row.touched = (cells + links) / ins;
+  row.peak_b = r.D("peak_kib") * 1024.0 / row.tets;
+  row.alloc_b = (r.D("peak_kib") - r.D("base_kib")) * 1024.0 / row.tets;
+  std::printf(
+      "| %s | %s | ok | %.0f | %.0f | %.0f | %.0f | %s | %s (%s/%s/%s) | %s | %s | %s (%s, %s) | %s | %s | %s | %s | %s "
+      "| %s |\n",
+      series.c_str(), param.c_str(), r.D("out_vertices"), row.tets, r.D("omega_vertices"), ins,
+      F(row.wall, 2).c_str(), F(row.cpu, 2).c_str(), F(r.D("cpu_prepare"), 2).c_str(),
+      F(r.D("cpu_refine"), 2).c_str(), F(r.D("cpu_output"), 2).c_str(), F(1e6 * row.cpu / row.tets, 2).c_str(),
+      F(1e6 * row.wall / row.tets, 2).c_str(), F(row.touched, 1).c_str(), F(cells / ins, 1).c_str(),
+      F(links / ins, 1).c_str(), F(r.D("peak_kib") / 1024.0, 1).c_str(), F(row.peak_b, 0).c_str(),
+      F(row.alloc_b, 0).c_str(), G(r.D("max_re")).c_str(), G(r.D("min_dih")).c_str(),
+      r.kv.count("verify") ? r.kv.at("verify").c_str() : "-");
+  std::fflush(stdout);
+  return row;
+}
+
+// max/min of `get` over the ok rows with ≥ 10^4 output tets.
+struct Spread {
+  double lo = 0, hi = 0;
+  int n = 0;
+};
+template <typename Get>
+Spread RangeOf(const std::vector<Row>& rows, Get get) {
+  Spread s;
+  for (const Row& r : rows) {
+    if (r.r.status != "OK" || r.tets < 1e4) continue;
+    const double v = get(r);
+    if (s.n == 0) s.lo = s.hi = v;
+    s.lo = std::min(s.lo, v);
+    s.hi = std::max(s.hi, v);
+    ++s.n;
+  }
+  return s;
+}
+
+void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
+  double tlo = 0, thi = 0;
+  int n = 0;
+  for (const Row& r : rows) {
+    if (r.r.status != "OK" || r.tets < 1e4) continue;
+    tlo = n == 0 ? r.tets : std::min(tlo, r.tets);
+    thi = n == 0 ? r.tets : std::max(thi, r.tets);
+    ++n;
+  }
+  if (n < 2) {
+    std::printf("- %s: fewer than 2 runs with >= 10^4 output tets, no verdict\n", series.c_str());
+    return;
+  }
+  std::printf("- %s: %d runs, %.3g .. %.3g output tets (×%.1f):", series.c_str(), n, tlo, thi, thi / tlo);
+  struct Measure {
+    const char* name;
+    double (*get)(const Row&);
+  };
+  const Measure measures[] = {
+      {"cpu µs/tet", [](const Row& r) { return 1e6 * r.cpu / r.tets; }},
+      {"wall µs/tet", [](const Row& r) { return 1e6 * r.wall / r.tets; }},
+      {"cells+links/insertion", [](const Row& r) { return r.touched; }},
+      {"peak B/tet", [](const Row& r) { return r.peak_b; }},
+      {"(peak − start) B/tet", [](const Row& r) { return r.alloc_b; }},
+  };
+  bool first = true;
+  for (const Measure& m : measures) {
+    const Spread s = RangeOf(rows, m.get);
+    std::printf("%s %s %.4g..%.4g = ×%.2f %s", first ? "" : ";", m.name, s.lo, s.hi, s.hi / s.lo,
+                s.hi / s.lo <= 1.5 ? "(flat within 1.5×: yes)" : "(flat within 1.5×: NO)");
+    first = false;
+  }
+  std::printf("\n");
+}
+
+std::vector<std::string> List(const std::string& s) {
+  std::vector<std::string> out;
+  for (absl::string_view p : absl::StrSplit(s, ',', absl::SkipEmpty())) out.emplace_back(p);
+  return out;
+}
+
+int Main(int argc, char** argv) {
+  double radius_edge = 2.0, timeout_s = 600;
+  uint64_t mem_mib = 8192;
+  bool verify = false;
+  std::string cube_volumes = "1e-4,3e-5,1e-5,3e-6,1e-6";
+  std::string skew_n = "100,300,1000,3000";
+  std::string skewvol_n = "100,300,1000,3000";
+  std::string skewvol_volume = "1e-4";
+  std::string spread_k = "1,2,3,4,5,6";
+  std::vector<std::string> series;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--one") {
+      std::vector<std::string> rest(argv + i + 1, argv + argc);
+      return RunOne(rest, radius_edge, verify);
+    } else if (a == "--radius-edge") {
+      radius_edge = std::atof(value().c_str());
+    } else if (a == "--timeout") {
+      timeout_s = std::atof(value().c_str());
+    } else if (a == "--mem-limit-mib") {
+      mem_mib = std::strtoull(value().c_str(), nullptr, 10);
+    } else if (a == "--verify") {
+      verify = true;
+    } else if (a == "--cube-volumes") {
+      cube_volumes = value();
+    } else if (a == "--skew-n") {
+      skew_n = value();
+    } else if (a == "--skewvol-n") {
+      skewvol_n = value();
+    } else if (a == "--skewvol-volume") {
+      skewvol_volume = value();
+    } else if (a == "--spread-k") {
+      spread_k = value();
+    } else if (a == "-h" || a == "--help") {
+      std::printf(
+          "usage: %s [--radius-edge 2] [--timeout 600] [--mem-limit-mib 8192] [--verify]\n"
+          "  [--cube-volumes 1e-4,...] [--skew-n 100,...] [--skewvol-n 100,...] [--skewvol-volume 1e-4]\n"
+          "  [--spread-k 1,...,6] [cube] [skew] [skewvol] [spread] [file:PATH]...\n",
+          argv[0]);
+      return 0;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "unknown flag %s\n", a.c_str());
+      return 2;
+    } else {
+      series.push_back(a);
+    }
+  }
+  if (series.empty()) series = {"cube", "skew", "skewvol", "spread"};
+  signal(SIGINT, KillChildAndExit);
+  signal(SIGTERM, KillChildAndExit);
+  signal(SIGHUP, KillChildAndExit);
+
+  std::printf("svrc_sensitivity_bench: radius-edge %g (tau %g), timeout %.0f s, RLIMIT_AS %llu MiB, %u hardware "
+              "threads\n\n",
+              radius_edge, 2 * radius_edge, timeout_s, (unsigned long long)mem_mib,
+              std::thread::hardware_concurrency());
+  PrintHeader();
+  std::vector<std::pair<std::string, std::vector<Row>>> all;
+  for (const std::string& s : series) {
+    std::vector<Row> rows;
+    if (s == "cube") {
+      for (const std::string& v : List(cube_volumes)) {
+        rows.push_back(Measure("cube", "max vol " + v, {"cube", v}, radius_edge, verify, timeout_s, mem_mib));
+      }
+    } else if (s == "skew") {
+      for (const std::string& n : List(skew_n)) {
+        rows.push_back(Measure("skew", "n " + n, {"skew", n, "0"}, radius_edge, verify, timeout_s, mem_mib));
+      }
+    } else if (s == "skewvol") {
+      for (const std::string& n : List(skewvol_n)) {
+        rows.push_back(Measure("skewvol", absl::StrCat("n ", n, ", max vol ", skewvol_volume),
+                               {"skew", n, skewvol_volume}, radius_edge, verify, timeout_s, mem_mib));
+      }
+    } else if (s == "spread") {
+      for (const std::string& k : List(spread_k)) {
+        rows.push_back(Measure("spread", "side 1e-" + k, {"spread", k}, radius_edge, verify, timeout_s, mem_mib));
+      }
+    } else if (s.rfind("file:", 0) == 0) {
+      rows.push_back(Measure("file", s.substr(5), {"file", s.substr(5)}, radius_edge, verify, timeout_s, mem_mib));
+    } else {
+      std::fprintf(stderr, "unknown series %s\n", s.c_str());
+      return 2;
+    }
+    all.emplace_back(s, std::move(rows));
+  }
+
+  std::printf("\nFlatness over the runs with >= 10^4 output tets (max/min; the issue asks <= 1.5):\n\n");
+  for (const auto& [name, rows] : all) {
+    if (name == "spread" || name.rfind("file:", 0) == 0) continue;
+    PrintFlatness(name, rows);
+  }
+  for (const auto& [name, rows] : all) {
+    if (name != "spread") continue;
+    std::printf("\nSpread (log Δ = k): per decade of Δ, the growth of output vertices and CPU time:\n\n");
+    std::printf("| k | output vertices | Δ vertices vs k−1 | cpu s | Δ cpu s vs k−1 |\n|---|---|---|---|---|\n");
+    const Row* prev = nullptr;
+    for (const Row& r : rows) {
+      if (r.r.status != "OK") continue;
+      const double v = r.r.D("out_vertices");
+      std::printf("| %s | %.0f | %s | %s | %s |\n", r.param.c_str(), v,
+                  prev ? F(v - prev->r.D("out_vertices"), 0).c_str() : "-", F(r.cpu, 3).c_str(),
+                  prev ? F(r.cpu - prev->cpu, 3).c_str() : "-");
+      prev = &r;
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace svrc::bench
+
+int main(int argc, char** argv) { return svrc::bench::Main(argc, argv); }
