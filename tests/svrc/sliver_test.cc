@@ -1,0 +1,358 @@
+// Sliver removal by flips (core/svrc/sliver.h): hand-built 3-2 and 4-4
+// configurations, constrained faces/edges that must block a flip, and random
+// Delaunay meshes whose union, boundary, constraints and orientation must
+// survive the pass while the worst dihedral angle does not get worse.
+#include "core/svrc/sliver.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "core/delaunay/point_set.h"
+#include "core/geometry/predicates.h"
+#include "core/mesh/quality.h"
+#include "gtest/gtest.h"
+
+namespace svrc::refine {
+namespace {
+
+using geom::Vec3;
+using Tet = std::array<uint32_t, 4>;
+using Tri = std::array<uint32_t, 3>;
+using Edge = std::array<uint32_t, 2>;
+
+// Writes t positively oriented (swaps two vertices if needed).
+Tet Positive(const std::vector<Vec3>& pos, Tet t) {
+  if (geom::Orient3d(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]) < 0) std::swap(t[2], t[3]);
+  return t;
+}
+
+// Evaluated on the sorted vertices, as the pass does (the value then does not
+// depend on the order a tet is written in).
+double MinDihedral(const std::vector<Vec3>& pos, Tet t) {
+  std::sort(t.begin(), t.end());
+  return mesh::ComputeTetQuality(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]).min_dihedral_deg;
+}
+
+double WorstDihedral(const std::vector<Vec3>& pos, const std::vector<Tet>& tets) {
+  double w = 180;
+  for (const Tet& t : tets) w = std::min(w, MinDihedral(pos, t));
+  return w;
+}
+
+double Volume(const std::vector<Vec3>& pos, const std::vector<Tet>& tets) {
+  double v = 0;
+  for (const Tet& t : tets) {
+    const Vec3 a = pos[t[0]];
+    v += geom::Dot(pos[t[1]] - a, geom::Cross(pos[t[2]] - a, pos[t[3]] - a)) / 6;
+  }
+  return v;
+}
+
+// The oriented faces of a tet (outward normal by the right-hand rule, in a
+// canonical rotation: smallest id first).
+std::array<Tri, 4> OrientedFaces(const Tet& t) {
+  // Boundary of [v0,v1,v2,v3]: +[v1,v2,v3] −[v0,v2,v3] +[v0,v1,v3] −[v0,v1,v2]
+  // (signs folded into the order); with Orient3d(v0,v1,v2,v3) > 0 the
+  // opposite vertex is on the negative side of each: outward.
+  std::array<Tri, 4> f = {Tri{t[1], t[2], t[3]}, Tri{t[0], t[3], t[2]}, Tri{t[0], t[1], t[3]},
+                          Tri{t[0], t[2], t[1]}};
+  for (Tri& x : f) {
+    while (x[0] > x[1] || x[0] > x[2]) x = {x[1], x[2], x[0]};
+  }
+  return f;
+}
+
+Tri Sorted(Tri t) {
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+// Checks that `tets` is a proper tetrahedralization (every tet strictly
+// positive by exact Orient3d; every face in one tet, or in two with opposite
+// orientations) and returns its boundary faces (oriented, canonical, sorted).
+std::vector<Tri> CheckedBoundary(const std::vector<Vec3>& pos, const std::vector<Tet>& tets) {
+  std::map<Tri, std::vector<Tri>> by_key;  // sorted key -> oriented faces
+  for (const Tet& t : tets) {
+    EXPECT_GT(geom::Orient3d(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]), 0)
+        << t[0] << " " << t[1] << " " << t[2] << " " << t[3];
+    for (const Tri& f : OrientedFaces(t)) by_key[Sorted(f)].push_back(f);
+  }
+  std::vector<Tri> boundary;
+  for (const auto& [key, fs] : by_key) {
+    EXPECT_LE(fs.size(), 2u) << key[0] << " " << key[1] << " " << key[2];
+    if (fs.size() == 1) {
+      boundary.push_back(fs[0]);
+    } else if (fs.size() == 2) {
+      EXPECT_NE(fs[0], fs[1]) << "face with the same orientation in two tets";
+    }
+  }
+  std::sort(boundary.begin(), boundary.end());
+  return boundary;
+}
+
+bool HasFace(const std::vector<Tet>& tets, Tri f) {
+  f = Sorted(f);
+  for (const Tet& t : tets) {
+    for (int i = 0; i < 4; ++i) {
+      Tri g{};
+      for (int j = 0, k = 0; j < 4; ++j) {
+        if (j != i) g[k++] = t[j];
+      }
+      if (Sorted(g) == f) return true;
+    }
+  }
+  return false;
+}
+
+bool HasEdge(const std::vector<Tet>& tets, Edge e) {
+  for (const Tet& t : tets) {
+    int hits = 0;
+    for (uint32_t v : t) hits += (v == e[0] || v == e[1]);
+    if (hits == 2) return true;
+  }
+  return false;
+}
+
+// Three tets around the edge pq (p above, q below the plane z = 0); the ring
+// vertices u0 = (1,0,0) and u1 = (−1, 0.02, 0) are nearly opposite, so the
+// tet (p, q, u0, u1) is a sliver: four nearly coplanar points whose
+// "diagonals" pq and u0u1 pass 0.01 apart. The 3-2 flip to the two tets over
+// the triangle u0u1u2 removes it.
+struct ThreeRing {
+  std::vector<Vec3> pos = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0.02, 0}, {0, -1, 0}};
+  std::vector<Tet> tets;
+  ThreeRing() {
+    for (uint32_t i = 0; i < 3; ++i) tets.push_back(Positive(pos, {0, 1, 2 + i, 2 + (i + 1) % 3}));
+  }
+};
+
+TEST(Sliver, ThreeTwoFlipRemovesSliverBetweenTwoTets) {
+  ThreeRing ring;
+  ASSERT_LT(WorstDihedral(ring.pos, ring.tets), 2.0);
+  SliverInput in{ring.pos, ring.tets, {}, {}};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips_32, 1u);
+  EXPECT_EQ(r->stats.flips(), 1u);
+  ASSERT_EQ(r->tets.size(), 2u);
+  EXPECT_FALSE(HasEdge(r->tets, {0, 1}));
+  EXPECT_TRUE(HasFace(r->tets, {2, 3, 4}));
+  EXPECT_EQ(CheckedBoundary(ring.pos, r->tets), CheckedBoundary(ring.pos, ring.tets));
+  EXPECT_NEAR(Volume(ring.pos, r->tets), Volume(ring.pos, ring.tets), 1e-14);
+  EXPECT_GT(WorstDihedral(ring.pos, r->tets), 30.0);
+  EXPECT_EQ(r->stats.bad_before, 1u);
+  EXPECT_EQ(r->stats.bad_after, 0u);
+  EXPECT_EQ(r->stats.tets_before, 3u);
+  EXPECT_EQ(r->stats.tets_after, 2u);
+  EXPECT_LT(r->stats.min_dihedral_before, 2.0);
+  EXPECT_DOUBLE_EQ(r->stats.min_dihedral_after, WorstDihedral(ring.pos, r->tets));
+}
+
+TEST(Sliver, ConstrainedEdgeBlocksTheFlip) {
+  ThreeRing ring;
+  const std::vector<Edge> edges = {{1, 0}};  // pq, any order
+  SliverInput in{ring.pos, ring.tets, {}, edges};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);
+  EXPECT_EQ(r->tets, ring.tets);
+  EXPECT_GE(r->stats.rejected_constraint, 1u);
+  EXPECT_EQ(r->stats.bad_after, 1u);
+}
+
+TEST(Sliver, ConstrainedFaceBlocksTheFlip) {
+  ThreeRing ring;
+  // One of the three faces around pq (the 3-2 flip removes all three).
+  const std::vector<Tri> faces = {{4, 0, 1}};
+  SliverInput in{ring.pos, ring.tets, faces, {}};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);
+  EXPECT_EQ(r->tets, ring.tets);
+  EXPECT_TRUE(HasFace(r->tets, {0, 1, 4}));
+}
+
+// The radius-edge bound: the three ring tets have radius-edge 0.70711 (their
+// circumcentre is the origin), the two tets of the 3-2 flip 0.70716. A bound
+// of 0.5 counts as max(0.5, 0.70711 of the replaced tets) and blocks the
+// flip; 0.75 lets it through.
+TEST(Sliver, RadiusEdgeBoundBlocksTheFlip) {
+  ThreeRing ring;
+  SliverInput in{ring.pos, ring.tets, {}, {}};
+  SliverOptions opt;
+  opt.max_radius_edge = 0.5;
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);
+  EXPECT_GE(r->stats.rejected_radius_edge, 1u);
+  EXPECT_EQ(r->tets, ring.tets);
+  EXPECT_NEAR(r->stats.max_radius_edge_after, std::sqrt(0.5), 1e-4);
+  opt.max_radius_edge = 0.75;
+  r = RemoveSlivers(in, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips_32, 1u);
+  EXPECT_GT(r->stats.max_radius_edge_after, std::sqrt(0.5));
+  EXPECT_LE(r->stats.max_radius_edge_after, 0.75);
+}
+
+// An octahedron around the axis pq (vertices 0, 1) with an equator of four
+// points (2..5), found by a random search over small dyadic-ish decimals:
+// (p, q, u1, u2) is a sliver (min dihedral ~2.5°); of the 2-3 flips across
+// the faces around pq and the two 4-4 flips (diagonal u0u2 or u1u3), the
+// 4-4 flip is best (worst dihedral ~34°).
+TEST(Sliver, FourFourFlipInOctahedron) {
+  const std::vector<Vec3> pos = {{0.297, 0.006, 0.68},   {0.018, -0.051, -1.01},   {0.15, 0.77, -0.2475},
+                                 {0.21, -0.88, -0.15},   {-0.5, -0.49, -0.2325},   {-0.91, 0.34, -0.21}};
+  std::vector<Tet> tets;
+  for (uint32_t i = 0; i < 4; ++i) {
+    const Tet t{0, 1, 2 + i, 2 + (i + 1) % 4};
+    ASSERT_GT(geom::Orient3d(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]), 0);
+    tets.push_back(t);
+  }
+  const double before = WorstDihedral(pos, tets);
+  ASSERT_LT(before, 3.0);
+  SliverOptions opt;
+  opt.target_min_dihedral_deg = 10;
+  SliverInput in{pos, tets, {}, {}};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips_44, 1u);
+  EXPECT_EQ(r->stats.flips(), 1u);
+  ASSERT_EQ(r->tets.size(), 4u);
+  EXPECT_FALSE(HasEdge(r->tets, {0, 1}));
+  EXPECT_TRUE(HasEdge(r->tets, {2, 4}) || HasEdge(r->tets, {3, 5}));
+  EXPECT_EQ(CheckedBoundary(pos, r->tets), CheckedBoundary(pos, tets));
+  EXPECT_NEAR(Volume(pos, r->tets), Volume(pos, tets), 1e-14);
+  EXPECT_GT(WorstDihedral(pos, r->tets), 25.0);
+  EXPECT_EQ(r->stats.bad_after, 0u);
+}
+
+TEST(Sliver, RejectsBadInput) {
+  ThreeRing ring;
+  {
+    const std::vector<Tri> faces = {{2, 3, 4}};  // not a face of the ring
+    SliverInput in{ring.pos, ring.tets, faces, {}};
+    EXPECT_EQ(RemoveSlivers(in, {}).status().code(), absl::StatusCode::kInvalidArgument);
+  }
+  {
+    const std::vector<Edge> edges = {{2, 9}};
+    SliverInput in{ring.pos, ring.tets, {}, edges};
+    EXPECT_EQ(RemoveSlivers(in, {}).status().code(), absl::StatusCode::kInvalidArgument);
+  }
+  {
+    std::vector<Tet> inverted = ring.tets;
+    std::swap(inverted[1][0], inverted[1][1]);
+    SliverInput in{ring.pos, inverted, {}, {}};
+    EXPECT_EQ(RemoveSlivers(in, {}).status().code(), absl::StatusCode::kInvalidArgument);
+  }
+  {
+    std::vector<Tet> three = ring.tets;
+    three.push_back(ring.tets[0]);  // a face in three tets (the same tet twice)
+    SliverInput in{ring.pos, three, {}, {}};
+    EXPECT_EQ(RemoveSlivers(in, {}).status().code(), absl::StatusCode::kInvalidArgument);
+  }
+}
+
+// The pipeline form: ConstrainedFace list and segment chains.
+TEST(Sliver, PipelineFormTakesChainsAsEdges) {
+  ThreeRing ring;
+  const std::vector<std::vector<uint32_t>> chains = {{4, 0, 1}};  // edges 4-0 and 0-1
+  absl::StatusOr<SliverResult> r = RemoveSlivers(ring.pos, ring.tets, {}, chains, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);  // 0-1 is pq
+  std::vector<ConstrainedFace> faces(1);
+  faces[0].v = {0, 1, 3};
+  r = RemoveSlivers(ring.pos, ring.tets, faces, {}, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);
+  r = RemoveSlivers(ring.pos, ring.tets, {}, {}, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips_32, 1u);
+}
+
+// Random Delaunay meshes (core/delaunay/point_set.h), with every 5th interior
+// face and every 7th edge constrained: after the pass the tets are a proper
+// tetrahedralization of the same union with the same boundary, every
+// constraint is still there, the worst dihedral is not worse, no tet is above
+// max(bound, the input's worst radius-edge), and two runs give the same tets.
+TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
+  for (uint64_t seed : {1u, 2u, 3u}) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<Vec3> pos;
+    for (int i = 0; i < 400; ++i) pos.push_back({u(rng), u(rng), u(rng)});
+    // A jittered grid layer: near-cospherical groups make Delaunay slivers.
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) {
+        for (int k = 0; k < 3; ++k) {
+          pos.push_back({0.1 + 0.15 * i + 1e-3 * u(rng), 0.1 + 0.15 * j + 1e-3 * u(rng), 1.2 + 0.15 * k + 1e-3 * u(rng)});
+        }
+      }
+    }
+    absl::StatusOr<delaunay::PointSetResult> del = delaunay::TetrahedralizePointSet(pos);
+    ASSERT_TRUE(del.ok()) << del.status();
+    const std::vector<Tet> tets = del->tets;
+    const std::vector<Tri> boundary = CheckedBoundary(pos, tets);
+    std::vector<Tri> faces;
+    std::vector<Edge> edges;
+    {
+      std::map<Tri, int> count;
+      for (const Tet& t : tets) {
+        for (const Tri& f : OrientedFaces(t)) ++count[Sorted(f)];
+      }
+      int k = 0;
+      for (const auto& [f, c] : count) {
+        if (c == 2 && k++ % 5 == 0) faces.push_back(f);
+      }
+      std::vector<Edge> all;
+      for (const Tet& t : tets) {
+        for (int i = 0; i < 4; ++i) {
+          for (int j = i + 1; j < 4; ++j) all.push_back({std::min(t[i], t[j]), std::max(t[i], t[j])});
+        }
+      }
+      std::sort(all.begin(), all.end());
+      all.erase(std::unique(all.begin(), all.end()), all.end());
+      for (size_t i = 0; i < all.size(); i += 7) edges.push_back(all[i]);
+    }
+    double max_re = 0;
+    for (const Tet& t : tets) {
+      max_re = std::max(max_re, mesh::ComputeTetQuality(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]).radius_edge);
+    }
+    SliverOptions opt;
+    opt.target_min_dihedral_deg = 15;
+    opt.max_radius_edge = 2;
+    SliverInput in{pos, tets, faces, edges};
+    absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+    ASSERT_TRUE(r.ok()) << r.status();
+    const SliverStats& s = r->stats;
+    SCOPED_TRACE(testing::Message() << "seed " << seed << ": tets " << s.tets_before << " -> " << s.tets_after
+                                    << ", bad " << s.bad_before << " -> " << s.bad_after << ", worst "
+                                    << s.min_dihedral_before << " -> " << s.min_dihedral_after << ", flips 23/32/44 "
+                                    << s.flips_23 << "/" << s.flips_32 << "/" << s.flips_44);
+    EXPECT_GT(s.flips(), 0u);
+    EXPECT_EQ(CheckedBoundary(pos, r->tets), boundary);
+    EXPECT_NEAR(Volume(pos, r->tets), Volume(pos, tets), 1e-12);
+    for (const Tri& f : faces) EXPECT_TRUE(HasFace(r->tets, f));
+    for (const Edge& e : edges) EXPECT_TRUE(HasEdge(r->tets, e));
+    const double before = WorstDihedral(pos, tets), after = WorstDihedral(pos, r->tets);
+    EXPECT_GE(after, before);
+    EXPECT_DOUBLE_EQ(s.min_dihedral_before, before);
+    EXPECT_DOUBLE_EQ(s.min_dihedral_after, after);
+    EXPECT_LT(s.bad_after, s.bad_before);
+    EXPECT_EQ(s.tets_after, r->tets.size());
+    for (const Tet& t : r->tets) {
+      EXPECT_LE(mesh::ComputeTetQuality(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]).radius_edge,
+                std::max(2.0, max_re) * (1 + 1e-12));
+    }
+    absl::StatusOr<SliverResult> again = RemoveSlivers(in, opt);
+    ASSERT_TRUE(again.ok());
+    EXPECT_EQ(again->tets, r->tets);
+  }
+}
+
+}  // namespace
+}  // namespace svrc::refine
