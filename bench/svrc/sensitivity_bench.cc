@@ -18,7 +18,9 @@
 // Flags: --radius-edge B (default 2: τ = 2B), --timeout S per run (default
 // 600), --mem-limit-mib M (RLIMIT_AS per child, default 8192), --verify (each
 // child also runs core::MeshPlc and checks that it gives the same mesh, bit
-// for bit: the bench measures what the product does).
+// for bit: the bench measures what the product does; a post-pass added to
+// MeshPlc later, e.g. sliver removal, shows up here as DIFFERENT and is not
+// timed by this bench).
 // Internal: --one cube V | skew n V | spread k | file PATH  (one run, prints
 // one "RESULT key=value ..." line).
 #include <fcntl.h>
@@ -315,14 +317,15 @@ struct Row {
   std::string series, param;
   RunResult r;
   double tets = 0, cpu = 0, wall = 0, touched = 0, peak_b = 0, alloc_b = 0;
+  double k = 0;  // spread: log10 of 1/side
 };
 
 void PrintHeader() {
   std::printf(
-      "| series | parameter | result | output vertices | output tets | M_Ω vertices | insertions | wall s | "
+      "| series | parameter | result | output vertices | output tets | M_Ω vertices | M_Ω tets | insertions | wall s | "
       "cpu s (prepare/refine/output) | cpu µs/tet | wall µs/tet | cells+links per insertion (cells, links) | "
       "peak RSS MiB | peak B/tet | (peak − start) B/tet | max r/e | min dih | MeshPlc same |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
 }
 
 Row Measure(const std::string& series, const std::string& param, const std::vector<std::string>& one_args,
@@ -334,7 +337,7 @@ Row Measure(const std::string& series, const std::string& param, const std::vect
   row.r = Spawn(one_args, radius_edge, verify, timeout_s, mem_mib);
   const RunResult& r = row.r;
   if (r.status != "OK") {
-    std::printf("| %s | %s | %s | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - |\n", series.c_str(),
+    std::printf("| %s | %s | %s | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - |\n", series.c_str(),
                 param.c_str(), r.status.c_str());
     std::fflush(stdout);
     return row;
@@ -348,9 +351,9 @@ Row Measure(const std::string& series, const std::string& param, const std::vect
   row.peak_b = r.D("peak_kib") * 1024.0 / row.tets;
   row.alloc_b = (r.D("peak_kib") - r.D("base_kib")) * 1024.0 / row.tets;
   std::printf(
-      "| %s | %s | ok | %.0f | %.0f | %.0f | %.0f | %s | %s (%s/%s/%s) | %s | %s | %s (%s, %s) | %s | %s | %s | %s | %s "
-      "| %s |\n",
-      series.c_str(), param.c_str(), r.D("out_vertices"), row.tets, r.D("omega_vertices"), ins,
+      "| %s | %s | ok | %.0f | %.0f | %.0f | %.0f | %.0f | %s | %s (%s/%s/%s) | %s | %s | %s (%s, %s) | %s | %s | %s | %s "
+      "| %s | %s |\n",
+      series.c_str(), param.c_str(), r.D("out_vertices"), row.tets, r.D("omega_vertices"), r.D("omega_tets"), ins,
       F(row.wall, 2).c_str(), F(row.cpu, 2).c_str(), F(r.D("cpu_prepare"), 2).c_str(),
       F(r.D("cpu_refine"), 2).c_str(), F(r.D("cpu_output"), 2).c_str(), F(1e6 * row.cpu / row.tets, 2).c_str(),
       F(1e6 * row.wall / row.tets, 2).c_str(), F(row.touched, 1).c_str(), F(cells / ins, 1).c_str(),
@@ -411,6 +414,34 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
     std::printf("%s %s %.4g..%.4g = ×%.2f %s", first ? "" : ";", m.name, s.lo, s.hi, s.hi / s.lo,
                 s.hi / s.lo <= 1.5 ? "(flat within 1.5×: yes)" : "(flat within 1.5×: NO)");
     first = false;
+  }
+  std::printf("\n");
+  // Diagnostics, not the criterion: per tet of the whole M_Ω (the
+  // bounding-domain mesh the refiner builds, output or not), and the marginal
+  // cost between consecutive runs (a fixed per-run cost cancels out).
+  const Measure omega[] = {
+      {"cpu µs per M_Ω tet", [](const Row& r) { return 1e6 * r.cpu / r.r.D("omega_tets"); }},
+      {"(peak − start) B per M_Ω tet",
+       [](const Row& r) { return (r.r.D("peak_kib") - r.r.D("base_kib")) * 1024.0 / r.r.D("omega_tets"); }},
+  };
+  std::printf("  - diagnostics:");
+  first = true;
+  for (const Measure& m : omega) {
+    const Spread s = RangeOf(rows, m.get);
+    std::printf("%s %s %.4g..%.4g = ×%.2f", first ? "" : ";", m.name, s.lo, s.hi, s.hi / s.lo);
+    first = false;
+  }
+  std::printf("; marginal cost between consecutive runs (Δcpu/Δtets µs, Δ(peak − start)/Δtets B):");
+  const Row* prev = nullptr;
+  for (const Row& r : rows) {
+    if (r.r.status != "OK") continue;
+    if (prev != nullptr && r.tets > prev->tets) {
+      const double dt = r.tets - prev->tets;
+      const double dmem = (r.r.D("peak_kib") - r.r.D("base_kib") - prev->r.D("peak_kib") + prev->r.D("base_kib")) *
+                          1024.0;
+      std::printf(" %.3g→%.3g: %.1f µs, %.0f B;", prev->tets, r.tets, 1e6 * (r.cpu - prev->cpu) / dt, dmem / dt);
+    }
+    prev = &r;
   }
   std::printf("\n");
 }
@@ -504,6 +535,7 @@ int Main(int argc, char** argv) {
     } else if (s == "spread") {
       for (const std::string& k : List(spread_k)) {
         rows.push_back(Measure("spread", "side 1e-" + k, {"spread", k}, radius_edge, verify, timeout_s, mem_mib));
+        rows.back().k = std::atof(k.c_str());
       }
     } else if (s.rfind("file:", 0) == 0) {
       rows.push_back(Measure("file", s.substr(5), {"file", s.substr(5)}, radius_edge, verify, timeout_s, mem_mib));
@@ -522,14 +554,16 @@ int Main(int argc, char** argv) {
   for (const auto& [name, rows] : all) {
     if (name != "spread") continue;
     std::printf("\nSpread (log Δ = k): per decade of Δ, the growth of output vertices and CPU time:\n\n");
-    std::printf("| k | output vertices | Δ vertices vs k−1 | cpu s | Δ cpu s vs k−1 |\n|---|---|---|---|---|\n");
+    std::printf("| k (side 10^-k) | output vertices | vertices per decade since previous row | cpu s | cpu s per "
+                "decade since previous row |\n|---|---|---|---|---|\n");
     const Row* prev = nullptr;
     for (const Row& r : rows) {
       if (r.r.status != "OK") continue;
       const double v = r.r.D("out_vertices");
-      std::printf("| %s | %.0f | %s | %s | %s |\n", r.param.c_str(), v,
-                  prev ? F(v - prev->r.D("out_vertices"), 0).c_str() : "-", F(r.cpu, 3).c_str(),
-                  prev ? F(r.cpu - prev->cpu, 3).c_str() : "-");
+      const double decades = prev ? r.k - prev->k : 0;
+      std::printf("| %g | %.0f | %s | %s | %s |\n", r.k, v,
+                  prev ? F((v - prev->r.D("out_vertices")) / decades, 0).c_str() : "-", F(r.cpu, 3).c_str(),
+                  prev ? F((r.cpu - prev->cpu) / decades, 3).c_str() : "-");
       prev = &r;
     }
   }
