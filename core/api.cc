@@ -1,5 +1,6 @@
 #include "core/api.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -10,6 +11,7 @@
 #include "core/plc/validate.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
+#include "core/svrc/sliver.h"
 
 namespace svrc::core {
 namespace {
@@ -87,6 +89,42 @@ absl::StatusOr<mesh::TetMesh> MeshPointSet(const plc::Plc& plc, const ProgressCa
   return out;
 }
 
+// The first crease of the complex, as "crease at segment (a, b): features meet
+// at X degrees" / "crease at point i (x, y, z)"; empty if none.
+// `sharpest` receives the smallest crease angle in degrees (0 for a crease
+// point off every crease segment: segments meeting at an acute angle).
+std::string FirstCrease(const plc::FeatureComplex& complex, double* sharpest) {
+  *sharpest = 90;
+  std::string first;
+  const plc::FeatureSegment* worst = nullptr;
+  std::vector<uint8_t> on_crease_segment(complex.points.size(), 0);
+  for (const plc::FeatureSegment& fs : complex.segments) {
+    if (!fs.crease) continue;
+    on_crease_segment[fs.a] = on_crease_segment[fs.b] = 1;
+    if (worst == nullptr || fs.min_angle < worst->min_angle) worst = &fs;
+  }
+  for (uint32_t i = 0; i < complex.points.size(); ++i) {
+    if (complex.points[i].crease && !on_crease_segment[i]) {
+      const geom::Vec3& p = complex.points[i].p;
+      *sharpest = 0;
+      return absl::StrCat("crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,
+                          "): segments or facets meet there below 90 degrees");
+    }
+  }
+  if (worst != nullptr) {
+    *sharpest = worst->min_angle * 180 / M_PI;
+    return absl::StrCat("crease at segment (", worst->a, ", ", worst->b, "): features meet at ", *sharpest,
+                        " degrees < 90");
+  }
+  for (uint32_t i = 0; i < complex.points.size(); ++i) {
+    if (complex.points[i].crease) {
+      const geom::Vec3& p = complex.points[i].p;
+      return absl::StrCat("crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z, "): features meet below 90 degrees");
+    }
+  }
+  return {};
+}
+
 // A PLC with segments or facets: SVRC refinement (core/svrc, thesis ch. 3),
 // then region labelling and assembly (docs/svrc-output.md).
 absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams& params,
@@ -141,8 +179,36 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     report("refine", vertices, queue, radius);
   };
   report("refine", 0, 0, 0);
+  // Creases (Definitions 4-5) need collars (issue #6, not built). Until then
+  // a creased PLC is refined through its creases under a small vertex budget
+  // (kCreaseBudget): mild creases often finish and then pass the conformity
+  // checker (b_internal/example.poly, 63°); the others end FAILED_PRECONDITION
+  // naming the first crease instead of refining towards the full budget.
+  double sharpest = 90;
+  const std::string crease = FirstCrease(*complex, &sharpest);
+  // Below this angle refinement without collars is hopeless (two facets at a
+  // small angle encroach each other's balls at every scale, thesis §1.4):
+  // refuse at once.
+  constexpr double kAttemptAngleDeg = 45;
+  if (!crease.empty() && sharpest < kAttemptAngleDeg) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "SVRC: ", crease, "; creases below ", kAttemptAngleDeg,
+        " degrees need collars (issue #6), not implemented yet"));
+  }
+  if (!crease.empty()) {
+    options.attempt_creases = true;
+    const uint64_t crease_budget = 20000 + 4 * static_cast<uint64_t>(complex->points.size());
+    if (options.max_vertices == 0 || options.max_vertices > crease_budget) options.max_vertices = crease_budget;
+  }
   absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
-  if (!refined.ok()) return refined.status();
+  if (!refined.ok()) {
+    if (!crease.empty() && refined.status().code() == absl::StatusCode::kResourceExhausted) {
+      return absl::FailedPreconditionError(absl::StrCat(
+          "SVRC: ", crease, "; refinement without collars did not finish within ", options.max_vertices,
+          " vertices (creases need collars, issue #6, not implemented yet)"));
+    }
+    return refined.status();
+  }
   const double seconds_refine = elapsed() - seconds_validate;
   report("assemble", refined->stats.vertices, 0, 0);
   std::vector<refine::ConstrainedFace> faces;
@@ -157,6 +223,17 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   }
   mesh::MeshStats stats;
   refined->stats.ExportTo(&stats);
+  // Sliver removal by flips (core/svrc/sliver.h; docs/svrc-output.md): keeps faces, segments, radius-edge, volumes.
+  refine::SliverOptions sliver;
+  sliver.max_radius_edge = params.radius_edge;
+  if (getenv("SVRC_SLIVER_TARGET")) sliver.target_min_dihedral_deg = atof(getenv("SVRC_SLIVER_TARGET"));  // TEMP
+  sliver.keep_max_volume = params.max_volume > 0 || std::any_of(plc.regions.begin(), plc.regions.end(),
+                                                                 [](const plc::RegionSeed& r) { return r.max_volume > 0; });
+  absl::StatusOr<refine::SliverResult> flipped = refine::RemoveSlivers(
+      refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver);
+  if (!flipped.ok()) return flipped.status();
+  flipped->stats.ExportTo(&stats);
+  refined->tets = std::move(flipped->tets);
   refine::CoordinateMap map;
   // The refiner's exact normalisation, recovered from an input point: the map
   // is x' = (x − t)·2^−e, identical on every axis scale.

@@ -818,6 +818,10 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy (facet) yielded without end");
+    // Each yield inserts into a segment mesh: the budget bounds the chain.
+    if (TotalVertices() >= budget_) {
+      return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached"));
+    }
     const VertexId2 w = m.dt().NearestVertex(c, hint);
     CellsMeetingDisk(f, c, r, w, &bfs2_);
     stats_.destroy_cells_visited += bfs2_.size();
@@ -837,7 +841,13 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
           if (points_.InMesh(p, mesh)) continue;
           const Vec2 q = Uv(f, p);
           const double d2 = (q.x - c.x) * (q.x - c.x) + (q.y - c.y) * (q.y - c.y);
-          if (d2 > theta_r2) continue;
+          // Destroying a triangle's disk, any unresolved lower point strictly
+          // inside it destroys the triangle: warp within r, not θr. A
+          // straddled piece is split towards the crossing until its new
+          // point falls inside the triangle; with θr, a crossing near the
+          // disk's rim was never reached (halving to the last ulp; measured
+          // on knife_edge.poly refined through its creases).
+          if (d2 > (tri.valid() ? r * r * (1 - 1e-9) : theta_r2)) continue;
           if (warp.valid()) {
             const Cd a = balls_.CdOf(b), wc = balls_.CdOf(warp);
             if (!(a < wc || (a == wc && (d2 < warp_d2 || (d2 == warp_d2 && p < balls_.VertexPoint(warp)))))) continue;
@@ -923,6 +933,9 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy yielded without end");
+    if (TotalVertices() >= budget_) {
+      return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached"));
+    }
     if (blg_.NumLinks() == 0) {
       // 𝓑 = ∅: nothing to warp or yield to.
       return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), kCdSpace), s.hint);
@@ -1624,7 +1637,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   if (complex.points.empty()) return absl::InvalidArgumentError("SVRC: the PLC has no points");
   // Creases (Definitions 4–5) need collars (issue #6): refuse them up front,
   // naming the first, rather than refine towards the budget.
-  for (uint32_t s = 0; s < complex.segments.size(); ++s) {
+  for (uint32_t s = 0; s < complex.segments.size() && !options.attempt_creases; ++s) {
     const plc::FeatureSegment& fs = complex.segments[s];
     if (fs.crease) {
       return absl::FailedPreconditionError(absl::StrCat(
@@ -1632,7 +1645,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
           " degrees < 90; creases need collars, not implemented yet"));
     }
   }
-  for (uint32_t i = 0; i < complex.points.size(); ++i) {
+  for (uint32_t i = 0; i < complex.points.size() && !options.attempt_creases; ++i) {
     if (complex.points[i].crease) {
       const Vec3& p = complex.points[i].p;
       return absl::FailedPreconditionError(absl::StrCat("SVRC: crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,

@@ -40,6 +40,9 @@ struct RefineOptions {
   // Size events apply to the whole Ω mesh (MeshParams::keep_bounding_box; a
   // PLC without facets has no inside, so its whole Ω mesh is output too).
   bool keep_bounding_box = false;
+  // RefinePlc: refine through creases instead of refusing them (no collars:
+  // may run to the budget; the caller bounds it). Default: refuse.
+  bool attempt_creases = false;
   // Called at every poll: vertices in all meshes, pending events, radius of
   // the event about to be destroyed (the largest work radius). May be null.
   std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;
