@@ -2,16 +2,16 @@
 # The main job on the bundled example, through the service. Assumes
 # scripts/setup.sh ran. Builds svrc and svrc-server, starts the server on a
 # free loopback port with a temporary data dir, submits
-# docs/examples/cube_points.node with --watch, writes the mesh to out/, prints
-# a summary and stops the server.
-# (The example is a point set: PLC meshing is not implemented yet.)
+# docs/examples/two_rooms.poly (a PLC: two rooms, an internal wall, a max
+# volume in one room) with --watch, writes the mesh to out/, prints a summary
+# and stops the server.
 # Env: SVRC_BUILD_DIR (default build/release), SVRC_EXAMPLE_OUT (default out),
 #      SVRC_SKIP_BUILD=1 to use the binaries already built (the ctest does).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${SVRC_BUILD_DIR:-build/release}
 OUT=${SVRC_EXAMPLE_OUT:-out}
-EXAMPLE=docs/examples/cube_points.node
+EXAMPLE=docs/examples/two_rooms.poly
 
 if [[ "${SVRC_SKIP_BUILD:-0}" != 1 ]]; then
   cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -45,8 +45,8 @@ echo "run-example: svrc-server listening on $addr (data dir $tmp/data)"
 "$SVRC" health --server "$addr"
 
 mkdir -p "$OUT"
-"$SVRC" submit "$EXAMPLE" --server "$addr" --watch -o "$OUT/cube_points.vtu"
+"$SVRC" submit "$EXAMPLE" --server "$addr" --watch -o "$OUT/two_rooms.vtu"
 "$SVRC" list --server "$addr"
 
-echo "run-example: mesh of $EXAMPLE written to $OUT/cube_points.vtu:"
-ls -l "$OUT"/cube_points*
+echo "run-example: mesh of $EXAMPLE written to $OUT/two_rooms.vtu:"
+ls -l "$OUT"/two_rooms*
