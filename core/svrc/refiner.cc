@@ -106,6 +106,9 @@ class Refiner {
   // sides, decided by the perturbation against it): enqueue it Encroached.
   // Returns whether anything was enqueued.
   bool EnqueueMissing();
+  bool OmegaHasEdge(PointId a, PointId b) const;
+  bool OmegaHasFace(PointId a, PointId b, PointId c) const;
+  bool FacetHasEdge(uint32_t f, PointId a, PointId b);
 
  private:
   // --- Destroy (Figure 3.4) -------------------------------------------------
@@ -438,8 +441,9 @@ void Refiner::CellsMeetingBall(const Vec3& c, double r, VertexId w, std::vector<
   out->push_back(w);
   mark_[w.value()] = stamp_;
   for (size_t i = 0; i < out->size(); ++i) {
-    dt.Neighbors((*out)[i], &nbrs_);
-    for (VertexId x : nbrs_) {
+    // A view into M_Ω's neighbour cache (no copy); valid until the next
+    // vertex query of dt, and the loop body makes none.
+    for (VertexId x : dt.NeighborsView((*out)[i])) {
       if (mark_[x.value()] == stamp_) continue;
       mark_[x.value()] = stamp_;
       if (may_meet(dt.Point(x))) out->push_back(x);
@@ -1424,33 +1428,52 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   return any;
 }
 
-bool Refiner::EnqueueMissing() {
-  std::vector<std::array<uint32_t, 3>> faces;
-  std::vector<std::array<uint32_t, 2>> edges;
-  OmegaSimplices(&faces, &edges);
-  bool more = false;
-  std::vector<std::vector<std::array<uint32_t, 2>>> facet_edges(facets_.size());
-  for (uint32_t f = 0; f < facets_.size(); ++f) {
-    const delaunay::Delaunay2& dt = facets_[f].dt();
-    for (TriId2 t : dt.Triangles()) {
-      for (int i = 0; i < 3; ++i) {
-        std::array<uint32_t, 2> e{facets_[f].PointOf(dt.TriVertex(t, i)).value(),
-                                  facets_[f].PointOf(dt.TriVertex(t, (i + 1) % 3)).value()};
-        std::sort(e.begin(), e.end());
-        facet_edges[f].push_back(e);
-      }
-    }
-    std::sort(facet_edges[f].begin(), facet_edges[f].end());
+bool Refiner::OmegaHasEdge(PointId a, PointId b) const {
+  const uint32_t va = points_.VertexIn(a, kOmegaMesh), vb = points_.VertexIn(b, kOmegaMesh);
+  if (va == PointStore::kNoVertex || vb == PointStore::kNoVertex) return false;
+  for (VertexId x : omega_.dt().NeighborsView(VertexId(va))) {
+    if (x.value() == vb) return true;
   }
+  return false;
+}
+
+bool Refiner::OmegaHasFace(PointId a, PointId b, PointId c) const {
+  const uint32_t va = points_.VertexIn(a, kOmegaMesh), vb = points_.VertexIn(b, kOmegaMesh),
+                 vc = points_.VertexIn(c, kOmegaMesh);
+  if (va == PointStore::kNoVertex || vb == PointStore::kNoVertex || vc == PointStore::kNoVertex) return false;
+  const delaunay::Delaunay3& dt = omega_.dt();
+  for (TetId t : dt.StarView(VertexId(va))) {
+    int hits = 0;
+    for (int k = 0; k < 4; ++k) {
+      const uint32_t w = dt.TetVertex(t, k).value();
+      hits += (w == vb) + (w == vc);
+    }
+    if (hits == 2) return true;
+  }
+  return false;
+}
+
+bool Refiner::FacetHasEdge(uint32_t f, PointId a, PointId b) {
+  const MeshId mesh = FacetMeshId(f);
+  const uint32_t va = points_.VertexIn(a, mesh), vb = points_.VertexIn(b, mesh);
+  if (va == PointStore::kNoVertex || vb == PointStore::kNoVertex) return false;
+  facets_[f].dt().Neighbors(VertexId2(va), &nbrs2_);
+  for (VertexId2 x : nbrs2_) {
+    if (x.value() == vb) return true;
+  }
+  return false;
+}
+
+bool Refiner::EnqueueMissing() {
+  // Local tests (O(degree) each) instead of sorting every simplex of M_Ω:
+  // this runs whenever the queues run dry (once per size round too).
+  bool more = false;
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
     SegmentMesh& m = segs_[sg];
     for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
-      std::array<uint32_t, 2> e{m.PointOf(v).value(), m.PointOf(m.Next(v)).value()};
-      std::sort(e.begin(), e.end());
-      bool missing = !std::binary_search(edges.begin(), edges.end(), e);
-      for (uint32_t fc : seg_facets_[sg]) {
-        missing = missing || !std::binary_search(facet_edges[fc].begin(), facet_edges[fc].end(), e);
-      }
+      const PointId a = m.PointOf(v), b = m.PointOf(m.Next(v));
+      bool missing = !OmegaHasEdge(a, b);
+      for (uint32_t fc : seg_facets_[sg]) missing = missing || !FacetHasEdge(fc, a, b);
       if (missing) {
         ++stats_.tied_balls;
         EnqueueEncroached(m.PieceBall(v));
@@ -1463,9 +1486,7 @@ bool Refiner::EnqueueMissing() {
     for (TriId2 t : dt.Triangles()) {
       const BallId b = facets_[f].TriBall(t);
       if (!b.valid()) continue;
-      std::array<uint32_t, 3> k{balls_.Vertex(b, 0).value(), balls_.Vertex(b, 1).value(), balls_.Vertex(b, 2).value()};
-      std::sort(k.begin(), k.end());
-      if (!std::binary_search(faces.begin(), faces.end(), k)) {
+      if (!OmegaHasFace(balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2))) {
         ++stats_.tied_balls;
         EnqueueEncroached(b);
         more = true;
