@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/mesh/quality.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/cli_util.h"
@@ -22,7 +23,8 @@ const Command kMesh{
     "mesh",
     "mesh IN -o OUT [--radius-edge X] [--max-volume V] [--theta T] [--max-rep-angle A] "
     "[--min-dihedral D] [--keep-bounding-box] [--max-vertices N] [--deadline 30s] "
-    "[--quantization-bits B] [--quiet]   (OUT: .node .vtu .msh .mesh .svrc)",
+    "[--quantization-bits B] [--quiet] [--stats]   (OUT: .node .vtu .msh .mesh .svrc; --stats: "
+    "the run's counters and the mesh quality)",
     &RunMesh};
 const RegisterCommand kRegister{kMesh};
 
@@ -31,6 +33,7 @@ int RunMesh(const std::vector<std::string>& argv) {
   values.push_back("-o");
   std::vector<std::string> switches = MeshSwitches();
   switches.push_back("--quiet");
+  switches.push_back("--stats");
   absl::StatusOr<Args> args = ParseArgs(argv, values, switches);
   if (!args.ok()) return UsageError(kMesh, std::string(args.status().message()));
   if (args->positional.size() != 1) return UsageError(kMesh, "expected one input file");
@@ -86,6 +89,10 @@ int RunMesh(const std::vector<std::string>& argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("wrote %s: %zu vertices, %zu tets, %zu boundary triangles in %.3f s\n", out.c_str(),
               mesh->num_vertices(), mesh->num_tets(), mesh->triangles.size(), seconds);
+  if (args->switches.count("--stats")) {
+    for (const auto& [name, value] : mesh->stats.counters) std::printf("  %-34s %.10g\n", name.c_str(), value);
+    std::fputs(mesh::FormatQualityReport(mesh::ComputeQuality(*mesh)).c_str(), stdout);
+  }
   return kExitOk;
 }
 

@@ -97,6 +97,7 @@ class Refiner {
   // refined to max_volume); a τ-well-spaced neighbour of a small cell is small.
   // Enqueues the cells above target; returns whether any was.
   absl::StatusOr<bool> SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume);
+  void CountSizeRound() { ++stats_.size_rounds; }
  private:
   // The sorted point-id faces and edges of M_Ω's finite tets.
   void OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces, std::vector<std::array<uint32_t, 2>>* edges) const;
@@ -763,10 +764,10 @@ absl::Status Refiner::Run() {
   if (!more) break;
   }
   const geom::PredicateStats& pred = geom::GetPredicateStats();
-  stats_.predicate_calls = pred.TotalCalls() - pred0.TotalCalls();
-  stats_.predicate_exact = pred.TotalExact() - pred0.TotalExact();
-  stats_.predicate_sos = pred.TotalSos() - pred0.TotalSos();
-  stats_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.predicate_calls += pred.TotalCalls() - pred0.TotalCalls();
+  stats_.predicate_exact += pred.TotalExact() - pred0.TotalExact();
+  stats_.predicate_sos += pred.TotalSos() - pred0.TotalSos();
+  stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return absl::OkStatus();
 }
 
@@ -1611,6 +1612,10 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
     out->Set(absl::StrCat("svrc.events_stale.", kTypes[i]), static_cast<double>(events_stale[i]));
   }
   out->Set("svrc.buckets_walked", static_cast<double>(buckets_walked));
+  out->Set("svrc.size_rounds", static_cast<double>(size_rounds));
+  out->Set("svrc.tied_balls", static_cast<double>(tied_balls));
+  out->Set("svrc.phantom_corners", static_cast<double>(phantom_corners));
+  out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
   out->Set("svrc.links_added", static_cast<double>(links_added));
   out->Set("svrc.links_removed", static_cast<double>(links_removed));
   out->Set("svrc.max_degree", max_degree);
@@ -1700,6 +1705,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
     absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
     if (!more.ok()) return more.status();
     if (!*more) break;
+    refiner.CountSizeRound();
     s = refiner.Run();
     if (!s.ok()) return s;
   }

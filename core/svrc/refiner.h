@@ -65,7 +65,8 @@ struct RefineStats {
   uint64_t duplicates = 0;         // warp targets equal to an existing vertex
   uint64_t phantom_corners = 0;    // clipped cell corners equal to an existing vertex (skipped)
   uint64_t tied_balls = 0;
-  uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
+  uint64_t straddle_yields = 0;
+  uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
