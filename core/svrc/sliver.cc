@@ -53,23 +53,56 @@ struct Quality {
   double min_dihedral = 0;  // degrees
   double max_dihedral = 0;
   double radius_edge = 0;
+  double volume = 0;  // unsigned, floating point
 };
 
 Quality Measure(std::span<const Vec3> pos, Tet t) {
   std::sort(t.begin(), t.end());
   const mesh::TetQuality q = mesh::ComputeTetQuality(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]);
-  return Quality{q.min_dihedral_deg, q.max_dihedral_deg, q.radius_edge};
+  return Quality{q.min_dihedral_deg, q.max_dihedral_deg, q.radius_edge, std::fabs(q.volume)};
 }
+
+// Edge removal (Shewchuk, "Two discrete optimization algorithms for the
+// topological improvement of tetrahedral meshes", 2002) handles rings of up
+// to kMaxRing tets around an edge: 3-2 (n = 3), 4-4 (n = 4), 5-6, 6-8, 7-10.
+// Klingner & Shewchuk found larger rings rarely help.
+constexpr int kMaxRing = 7;
+constexpr int kMaxNew = 2 * (kMaxRing - 2);
 
 // A flip under evaluation: the tets it replaces and the ones it creates.
 struct Flip {
-  enum Type { k23, k32, k44 } type = k23;
-  std::array<uint32_t, 4> old_tets{};
+  int ring = 0;  // 0: a 2-3 flip; n >= 3: removal of an edge with n tets around it
+  std::array<uint32_t, kMaxRing> old_tets{};
   int num_old = 0;
-  std::array<Tet, 4> new_tets{};
-  std::array<Quality, 4> new_quality{};
+  std::array<Tet, kMaxNew> new_tets{};
+  std::array<Quality, kMaxNew> new_quality{};
   int num_new = 0;
   double new_min = -kInf;  // worst smallest dihedral among the new tets
+  double old_min = kInf;   // worst smallest dihedral among the replaced tets
+
+  bool Replaces(uint32_t t) const {
+    for (int i = 0; i < num_old; ++i) {
+      if (old_tets[i] == t) return true;
+    }
+    return false;
+  }
+};
+
+// What a tentative flip changed, to undo it (the lookahead of Run).
+struct Journal {
+  struct Saved {
+    uint32_t slot;
+    Tet tet;
+    std::array<uint32_t, 4> nbr;
+    Quality quality;
+    uint32_t version;
+    uint32_t component;
+    uint8_t alive;
+  };
+  size_t num_slots = 0;  // tet_.size() before
+  size_t free_size = 0;
+  std::vector<uint32_t> free_tail;  // the last entries of free_ before
+  std::vector<Saved> saved;         // slot states before their first change
 };
 
 // The mutable tetrahedralization: flat arrays, slots reused through a free
@@ -93,18 +126,39 @@ class FlipMesh {
   bool EdgeConstrained(uint32_t a, uint32_t b) const {
     return std::binary_search(cedges_.begin(), cedges_.end(), SortedEdge(a, b));
   }
-  uint32_t Allocate();
+  uint32_t Allocate(Journal* journal);
+  void Save(uint32_t slot, Journal* journal) const;
+  void Undo(const Journal& journal);
   void Push(uint32_t t);
   // Ring of tets around edge (p, q) of tet t: ring vertices u_0..u_{k-1} with
   // (p, q, u_i, u_{i+1}) the positively oriented tet ring_tets[i]. False when
   // the ring is open (the edge is on the hull) or has more than max_size tets.
-  bool Ring(uint32_t t, uint32_t p, uint32_t q, int max_size, std::array<uint32_t, 4>* ring_tets,
-            std::array<uint32_t, 4>* ring_verts, int* size) const;
-  // Fills the quality of the new tets and checks orientation, gain and the
-  // radius-edge bound. True iff the flip is legal and an improvement.
-  bool Evaluate(Flip* flip);
-  bool BestFlip(uint32_t t, Flip* best);
-  void Apply(const Flip& flip, std::vector<uint32_t>* created);
+  bool Ring(uint32_t t, uint32_t p, uint32_t q, int max_size, std::array<uint32_t, kMaxRing>* ring_tets,
+            std::array<uint32_t, kMaxRing>* ring_verts, int* size) const;
+  // Quality of a would-be new tet, or nullopt-like false when it is not
+  // strictly positive (exact Orient3d) or breaks the radius-edge / volume
+  // bound (`re_bound`, `volume_bound`). Counts the rejection reason in `why`.
+  enum Reject { kOk = 0, kOrientation, kRadiusEdge, kVolume };
+  Reject NewTet(const Tet& t, double re_bound, double volume_bound, Quality* q) const;
+  // The 2-3 flip across face f of t, and the best removal of the edge
+  // (v[i], v[j]) of t. False when the flip is illegal (constraint, orientation,
+  // bounds); otherwise new_min/old_min are filled.
+  bool Build23(uint32_t t, int f, Flip* flip);
+  bool BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip);
+  // Every legal flip replacing t (2-3 across its faces, removal of its edges),
+  // in a fixed order.
+  template <typename Fn>
+  void ForEachFlip(uint32_t t, Fn&& fn);
+  // The legal flip replacing t with the largest new_min, among those with
+  // new_min > max(floor, their own old_min). False if none.
+  bool BestFlip(uint32_t t, double floor, Flip* best);
+  void Apply(const Flip& flip, std::vector<uint32_t>* created, Journal* journal);
+  void Count(const Flip& flip);
+  // Search for a stuck tet t: flips of nearby tets (not t) whose new tets are
+  // all better than `floor` (t's quality), up to depth − 1 of them, after
+  // which t has an improving flip. The best sequence (largest worst new
+  // quality) goes to `seq`; the mesh is left as it was.
+  bool Search(uint32_t t, int depth, double floor, std::vector<Flip>* seq, double* score);
 
   std::span<const Vec3> pos_;
   const SliverOptions& options_;
@@ -114,6 +168,8 @@ class FlipMesh {
   std::vector<Quality> quality_;
   std::vector<uint32_t> version_;
   std::vector<uint8_t> alive_;
+  std::vector<uint32_t> component_;            // per slot
+  std::vector<double> component_max_volume_;   // largest input tet volume per component
   std::vector<uint32_t> free_;
   std::vector<Tri> cfaces_;   // sorted, unique
   std::vector<Edge> cedges_;  // sorted, unique
@@ -216,30 +272,62 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   }
   std::sort(cedges_.begin(), cedges_.end());
   cedges_.erase(std::unique(cedges_.begin(), cedges_.end()), cedges_.end());
-  return CheckConstraints();
+  absl::Status s = CheckConstraints();
+  if (!s.ok()) return s;
+  // Components: flood fill across non-constrained faces, in tet order.
+  component_.assign(num_tets, kNone);
+  std::vector<uint32_t> stack;
+  for (uint32_t seed = 0; seed < num_tets; ++seed) {
+    if (component_[seed] != kNone) continue;
+    const uint32_t c = static_cast<uint32_t>(component_max_volume_.size());
+    component_max_volume_.push_back(0);
+    component_[seed] = c;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const uint32_t t = stack.back();
+      stack.pop_back();
+      component_max_volume_[c] = std::max(component_max_volume_[c], quality_[t].volume);
+      for (int f = 0; f < 4; ++f) {
+        const uint32_t n = nbr_[t][f];
+        if (n == kNone || component_[n] != kNone || FaceConstrained(FaceKey(tet_[t], f))) continue;
+        component_[n] = c;
+        stack.push_back(n);
+      }
+    }
+  }
+  return absl::OkStatus();
 }
 
 absl::Status FlipMesh::CheckConstraints() const {
-  std::vector<Tri> faces;
-  std::vector<Edge> edges;
+  // Vertex -> live tets (CSR); each constraint is looked up in the star of
+  // its first vertex. O(T + constraints · degree), no sort.
+  std::vector<uint32_t> start(pos_.size() + 1, 0);
   for (size_t t = 0; t < tet_.size(); ++t) {
     if (!alive_[t]) continue;
-    const Tet& v = tet_[t];
-    for (int f = 0; f < 4; ++f) faces.push_back(FaceKey(v, f));
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i + 1; j < 4; ++j) edges.push_back(SortedEdge(v[i], v[j]));
-    }
+    for (uint32_t v : tet_[t]) ++start[v + 1];
   }
-  std::sort(faces.begin(), faces.end());
-  std::sort(edges.begin(), edges.end());
+  for (size_t v = 0; v < pos_.size(); ++v) start[v + 1] += start[v];
+  std::vector<uint32_t> star(start.back());
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t t = 0; t < tet_.size(); ++t) {
+    if (!alive_[t]) continue;
+    for (uint32_t v : tet_[t]) star[fill[v]++] = static_cast<uint32_t>(t);
+  }
+  auto has = [&](const Tet& t, uint32_t v) { return t[0] == v || t[1] == v || t[2] == v || t[3] == v; };
   for (const Tri& f : cfaces_) {
-    if (!std::binary_search(faces.begin(), faces.end(), f)) {
+    bool found = false;
+    for (uint32_t k = start[f[0]]; k < start[f[0] + 1] && !found; ++k) {
+      found = has(tet_[star[k]], f[1]) && has(tet_[star[k]], f[2]);
+    }
+    if (!found) {
       return absl::InvalidArgumentError(
           absl::StrCat("sliver: constrained face (", f[0], ", ", f[1], ", ", f[2], ") is not a face of the mesh"));
     }
   }
   for (const Edge& e : cedges_) {
-    if (!std::binary_search(edges.begin(), edges.end(), e)) {
+    bool found = false;
+    for (uint32_t k = start[e[0]]; k < start[e[0] + 1] && !found; ++k) found = has(tet_[star[k]], e[1]);
+    if (!found) {
       return absl::InvalidArgumentError(
           absl::StrCat("sliver: constrained edge (", e[0], ", ", e[1], ") is not an edge of the mesh"));
     }
@@ -247,11 +335,12 @@ absl::Status FlipMesh::CheckConstraints() const {
   return absl::OkStatus();
 }
 
-uint32_t FlipMesh::Allocate() {
+uint32_t FlipMesh::Allocate(Journal* journal) {
   uint32_t t;
   if (!free_.empty()) {
     t = free_.back();
     free_.pop_back();
+    Save(t, journal);
   } else {
     t = static_cast<uint32_t>(tet_.size());
     tet_.push_back({});
@@ -259,10 +348,36 @@ uint32_t FlipMesh::Allocate() {
     quality_.push_back({});
     version_.push_back(0);
     alive_.push_back(0);
+    component_.push_back(0);
   }
   ++version_[t];
   alive_[t] = 1;
   return t;
+}
+
+void FlipMesh::Save(uint32_t slot, Journal* journal) const {
+  if (journal == nullptr || slot >= journal->num_slots) return;  // new slots are truncated on undo
+  journal->saved.push_back(
+      Journal::Saved{slot, tet_[slot], nbr_[slot], quality_[slot], version_[slot], component_[slot], alive_[slot]});
+}
+
+void FlipMesh::Undo(const Journal& journal) {
+  for (auto it = journal.saved.rbegin(); it != journal.saved.rend(); ++it) {
+    tet_[it->slot] = it->tet;
+    nbr_[it->slot] = it->nbr;
+    quality_[it->slot] = it->quality;
+    version_[it->slot] = it->version;
+    component_[it->slot] = it->component;
+    alive_[it->slot] = it->alive;
+  }
+  tet_.resize(journal.num_slots);
+  nbr_.resize(journal.num_slots);
+  quality_.resize(journal.num_slots);
+  version_.resize(journal.num_slots);
+  alive_.resize(journal.num_slots);
+  component_.resize(journal.num_slots);
+  free_.resize(journal.free_size - journal.free_tail.size());
+  free_.insert(free_.end(), journal.free_tail.begin(), journal.free_tail.end());
 }
 
 void FlipMesh::Push(uint32_t t) {
@@ -271,8 +386,8 @@ void FlipMesh::Push(uint32_t t) {
   }
 }
 
-bool FlipMesh::Ring(uint32_t t, uint32_t p, uint32_t q, int max_size, std::array<uint32_t, 4>* ring_tets,
-                    std::array<uint32_t, 4>* ring_verts, int* size) const {
+bool FlipMesh::Ring(uint32_t t, uint32_t p, uint32_t q, int max_size, std::array<uint32_t, kMaxRing>* ring_tets,
+                    std::array<uint32_t, kMaxRing>* ring_verts, int* size) const {
   const Tet& v = tet_[t];
   uint32_t x = kNone, y = kNone;
   for (int i = 0; i < 4; ++i) {
@@ -308,206 +423,331 @@ bool FlipMesh::Ring(uint32_t t, uint32_t p, uint32_t q, int max_size, std::array
   return true;
 }
 
-bool FlipMesh::Evaluate(Flip* flip) {
+FlipMesh::Reject FlipMesh::NewTet(const Tet& t, double re_bound, double volume_bound, Quality* q) const {
+  if (geom::Orient3d(pos_[t[0]], pos_[t[1]], pos_[t[2]], pos_[t[3]]) <= 0) return kOrientation;
+  *q = Measure(pos_, t);
+  if (!(q->radius_edge <= re_bound)) return kRadiusEdge;
+  if (options_.keep_max_volume && !(q->volume <= volume_bound)) return kVolume;
+  return kOk;
+}
+
+void CountReject(int why, SliverStats* stats) {
+  switch (why) {
+    case 1: ++stats->rejected_orientation; break;
+    case 2: ++stats->rejected_radius_edge; break;
+    case 3: ++stats->rejected_volume; break;
+    default: break;
+  }
+}
+
+bool FlipMesh::Build23(uint32_t t, int f, Flip* flip) {
+  const uint32_t n = nbr_[t][f];
+  if (n == kNone) return false;  // a hull face
   ++stats_->candidates;
-  for (int i = 0; i < flip->num_new; ++i) {
-    const Tet& v = flip->new_tets[i];
-    if (geom::Orient3d(pos_[v[0]], pos_[v[1]], pos_[v[2]], pos_[v[3]]) <= 0) {
-      ++stats_->rejected_orientation;
+  const Tet v = tet_[t];
+  const Tri face = FaceKey(v, f);
+  if (FaceConstrained(face)) {
+    ++stats_->rejected_constraint;
+    return false;
+  }
+  const Tet& w = tet_[n];
+  uint32_t e = kNone;
+  for (int i = 0; i < 4; ++i) {
+    if (w[i] != face[0] && w[i] != face[1] && w[i] != face[2]) e = w[i];
+  }
+  // t = (.., d = v[f], ..) and its neighbour n with apex e. Replacing, in
+  // turn, each vertex of the shared face by e gives the three tets around the
+  // new edge de; each is positive iff e lies on the same side as the replaced
+  // vertex, i.e. iff segment de crosses the face's interior.
+  flip->ring = 0;
+  flip->old_tets[0] = t;
+  flip->old_tets[1] = n;
+  flip->num_old = 2;
+  flip->old_min = std::min(quality_[t].min_dihedral, quality_[n].min_dihedral);
+  const double re_bound =
+      std::max(options_.max_radius_edge, std::max(quality_[t].radius_edge, quality_[n].radius_edge));
+  const double volume_bound = component_max_volume_[component_[t]];
+  flip->num_new = 0;
+  flip->new_min = kInf;
+  for (int i = 0; i < 4; ++i) {
+    if (i == f) continue;
+    Tet nt = v;
+    nt[i] = e;
+    Quality q;
+    const Reject why = NewTet(nt, re_bound, volume_bound, &q);
+    if (why != kOk) {
+      CountReject(why, stats_);
       return false;
     }
-  }
-  double old_min = kInf, old_max_re = 0;
-  for (int i = 0; i < flip->num_old; ++i) {
-    const Quality& q = quality_[flip->old_tets[i]];
-    old_min = std::min(old_min, q.min_dihedral);
-    old_max_re = std::max(old_max_re, q.radius_edge);
-  }
-  const double re_bound = std::max(options_.max_radius_edge, old_max_re);
-  double new_min = kInf;
-  bool re_ok = true;
-  for (int i = 0; i < flip->num_new; ++i) {
-    const Quality q = Measure(pos_, flip->new_tets[i]);
-    flip->new_quality[i] = q;
-    new_min = std::min(new_min, q.min_dihedral);
-    if (!(q.radius_edge <= re_bound)) re_ok = false;
-  }
-  flip->new_min = new_min;
-  if (!(new_min > old_min)) {
-    ++stats_->rejected_no_gain;
-    return false;
-  }
-  if (!re_ok) {
-    ++stats_->rejected_radius_edge;
-    return false;
+    flip->new_tets[flip->num_new] = nt;
+    flip->new_quality[flip->num_new++] = q;
+    flip->new_min = std::min(flip->new_min, q.min_dihedral);
   }
   return true;
 }
 
-bool FlipMesh::BestFlip(uint32_t t, Flip* best) {
-  bool found = false;
-  auto consider = [&](Flip& f) {
-    if (Evaluate(&f) && (!found || f.new_min > best->new_min)) {
-      *best = f;
-      found = true;
-    }
-  };
-  const Tet v = tet_[t];
-  // 2-3 across each face: t = (.., d = v[f], ..) and its neighbour n with apex
-  // e. Replacing, in turn, each vertex of the shared face by e gives the three
-  // tets around the new edge de; each is positive iff e lies on the same side
-  // as the replaced vertex, i.e. iff segment de crosses the face's interior.
-  for (int f = 0; f < 4; ++f) {
-    const uint32_t n = nbr_[t][f];
-    if (n == kNone) continue;
-    const Tri face = FaceKey(v, f);
-    if (FaceConstrained(face)) {
-      ++stats_->rejected_constraint;
-      continue;
-    }
-    const Tet& w = tet_[n];
-    uint32_t e = kNone;
-    for (int i = 0; i < 4; ++i) {
-      if (w[i] != face[0] && w[i] != face[1] && w[i] != face[2]) e = w[i];
-    }
-    Flip flip;
-    flip.type = Flip::k23;
-    flip.old_tets = {t, n, 0, 0};
-    flip.num_old = 2;
-    for (int i = 0, k = 0; i < 4; ++i) {
-      if (i == f) continue;
-      Tet nt = v;
-      nt[i] = e;
-      flip.new_tets[k++] = nt;
-    }
-    flip.num_new = 3;
-    consider(flip);
+bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
+  const uint32_t p = tet_[t][i], q = tet_[t][j];
+  std::array<uint32_t, kMaxRing> ring_tets{}, u{};
+  int n = 0;
+  if (!Ring(t, p, q, kMaxRing, &ring_tets, &u, &n)) return false;  // hull edge or ring too large
+  if (n < 3) return false;                                          // not in a valid mesh
+  ++stats_->candidates;
+  bool blocked = EdgeConstrained(p, q);
+  for (int k = 0; k < n && !blocked; ++k) blocked = FaceConstrained(SortedTri(p, q, u[k]));
+  if (blocked) {
+    ++stats_->rejected_constraint;
+    return false;
   }
-  // 3-2 and 4-4 removing each edge pq of t whose ring is closed with 3 or 4
-  // tets (p, q, u_i, u_{i+1}), all positive. Oriented boundary of that ring:
-  // +[q, u_i, u_{i+1}] and −[p, u_i, u_{i+1}]; the tets (u_0, u_1, u_2, q) and
-  // (u_1, u_0, u_2, p) have the same boundary (plus the inner face u_0u_1u_2
-  // with both signs), and so do the fans over a diagonal of the 4-ring.
-  // Positive tets with the boundary of the old ones tile exactly its union.
-  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  for (const auto& ij : kEdges) {
-    const uint32_t p = v[ij[0]], q = v[ij[1]];
-    std::array<uint32_t, 4> ring_tets{}, u{};
-    int k = 0;
-    if (!Ring(t, p, q, 4, &ring_tets, &u, &k)) continue;
-    if (k < 3) continue;  // not in a valid mesh
-    bool blocked = EdgeConstrained(p, q);
-    for (int i = 0; i < k && !blocked; ++i) blocked = FaceConstrained(SortedTri(p, q, u[i]));
-    if (blocked) {
-      ++stats_->rejected_constraint;
-      continue;
-    }
-    if (k == 3) {
-      Flip flip;
-      flip.type = Flip::k32;
-      flip.old_tets = {ring_tets[0], ring_tets[1], ring_tets[2], 0};
-      flip.num_old = 3;
-      flip.new_tets[0] = {u[0], u[1], u[2], q};
-      flip.new_tets[1] = {u[1], u[0], u[2], p};
-      flip.num_new = 2;
-      consider(flip);
-    } else {
-      for (int r = 0; r < 2; ++r) {
-        // Diagonal u_r u_{r+2}: triangles (u_r, u_{r+1}, u_{r+2}), (u_r, u_{r+2}, u_{r+3}).
-        const uint32_t a = u[r], b = u[r + 1], c = u[(r + 2) % 4], d = u[(r + 3) % 4];
-        Flip flip;
-        flip.type = Flip::k44;
-        flip.old_tets = ring_tets;
-        flip.num_old = 4;
-        flip.new_tets[0] = {a, b, c, q};
-        flip.new_tets[1] = {a, c, d, q};
-        flip.new_tets[2] = {b, a, c, p};
-        flip.new_tets[3] = {c, a, d, p};
-        flip.num_new = 4;
-        consider(flip);
+  double old_min = kInf, re_bound = options_.max_radius_edge;
+  for (int k = 0; k < n; ++k) {
+    old_min = std::min(old_min, quality_[ring_tets[k]].min_dihedral);
+    re_bound = std::max(re_bound, quality_[ring_tets[k]].radius_edge);
+  }
+  const double volume_bound = component_max_volume_[component_[t]];
+  // The ring's oriented boundary is +[q, u_k, u_k+1] and −[p, u_k, u_k+1].
+  // For a triangulation of the ring polygon u_0..u_{n-1} (triangles in ring
+  // order), the tets (a, b, c, q) and (b, a, c, p) over its triangles have the
+  // same boundary; positive tets with the boundary of the old ones tile
+  // exactly their union. Best triangulation (largest worst quality) by
+  // dynamic programming over polygon intervals (Shewchuk 2002, Klincsek 1980):
+  // best[a][b] = max over a < c < b of min(best[a][c], best[c][b], tri(a, c, b)).
+  double tri[kMaxRing][kMaxRing][kMaxRing];
+  Quality tri_q[kMaxRing][kMaxRing][kMaxRing][2];
+  int worst_reject = kOk;
+  for (int a = 0; a < n; ++a) {
+    for (int c = a + 1; c < n; ++c) {
+      for (int b = c + 1; b < n; ++b) {
+        tri[a][c][b] = -kInf;
+        const Tet up{u[a], u[c], u[b], q}, down{u[c], u[a], u[b], p};
+        const Reject r1 = NewTet(up, re_bound, volume_bound, &tri_q[a][c][b][0]);
+        const Reject r2 = r1 == kOk ? NewTet(down, re_bound, volume_bound, &tri_q[a][c][b][1]) : kOk;
+        if (r1 != kOk || r2 != kOk) {
+          worst_reject = std::max(worst_reject, static_cast<int>(r1 != kOk ? r1 : r2));
+          continue;
+        }
+        tri[a][c][b] = std::min(tri_q[a][c][b][0].min_dihedral, tri_q[a][c][b][1].min_dihedral);
       }
     }
   }
+  double best[kMaxRing][kMaxRing];
+  int arg[kMaxRing][kMaxRing];
+  for (int len = 1; len < n; ++len) {
+    for (int a = 0; a + len < n; ++a) {
+      const int b = a + len;
+      if (len == 1) {
+        best[a][b] = kInf;
+        arg[a][b] = -1;
+        continue;
+      }
+      best[a][b] = -kInf;
+      arg[a][b] = -1;
+      for (int c = a + 1; c < b; ++c) {
+        const double v = std::min(std::min(best[a][c], best[c][b]), tri[a][c][b]);
+        if (v > best[a][b]) {  // ties: the smallest c
+          best[a][b] = v;
+          arg[a][b] = c;
+        }
+      }
+    }
+  }
+  if (!(best[0][n - 1] > -kInf)) {
+    CountReject(worst_reject == kOk ? kOrientation : worst_reject, stats_);
+    return false;
+  }
+  flip->ring = n;
+  flip->num_old = n;
+  for (int k = 0; k < n; ++k) flip->old_tets[k] = ring_tets[k];
+  flip->old_min = old_min;
+  flip->new_min = best[0][n - 1];
+  flip->num_new = 0;
+  int stack[kMaxRing][2];
+  int top = 0;
+  stack[top][0] = 0;
+  stack[top++][1] = n - 1;
+  while (top > 0) {
+    --top;
+    const int a = stack[top][0], b = stack[top][1];
+    const int c = arg[a][b];
+    if (c < 0) continue;
+    flip->new_tets[flip->num_new] = {u[a], u[c], u[b], q};
+    flip->new_quality[flip->num_new++] = tri_q[a][c][b][0];
+    flip->new_tets[flip->num_new] = {u[c], u[a], u[b], p};
+    flip->new_quality[flip->num_new++] = tri_q[a][c][b][1];
+    stack[top][0] = a;
+    stack[top++][1] = c;
+    stack[top][0] = c;
+    stack[top++][1] = b;
+  }
+  return true;
+}
+
+template <typename Fn>
+void FlipMesh::ForEachFlip(uint32_t t, Fn&& fn) {
+  for (int f = 0; f < 4; ++f) {
+    Flip flip;
+    if (Build23(t, f, &flip)) fn(flip);
+  }
+  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  for (const auto& ij : kEdges) {
+    Flip flip;
+    if (BuildEdgeRemoval(t, ij[0], ij[1], &flip)) fn(flip);
+  }
+}
+
+bool FlipMesh::BestFlip(uint32_t t, double floor, Flip* best) {
+  bool found = false;
+  ForEachFlip(t, [&](const Flip& f) {
+    if (!(f.new_min > f.old_min) || !(f.new_min > floor)) {
+      ++stats_->rejected_no_gain;
+      return;
+    }
+    if (!found || f.new_min > best->new_min) {
+      *best = f;
+      found = true;
+    }
+  });
   return found;
 }
 
-void FlipMesh::Apply(const Flip& flip, std::vector<uint32_t>* created) {
+void FlipMesh::Apply(const Flip& flip, std::vector<uint32_t>* created, Journal* journal) {
   // The outer faces of the replaced tets and who is across them.
   struct Outer {
     Tri key;
     uint32_t tet;  // kNone: a hull face
   };
-  std::array<Outer, 16> outer{};
+  std::array<Outer, 4 * kMaxRing> outer{};
   int num_outer = 0;
-  auto is_old = [&](uint32_t x) {
-    for (int i = 0; i < flip.num_old; ++i) {
-      if (flip.old_tets[i] == x) return true;
-    }
-    return false;
-  };
   for (int i = 0; i < flip.num_old; ++i) {
     const uint32_t o = flip.old_tets[i];
     for (int f = 0; f < 4; ++f) {
       const uint32_t n = nbr_[o][f];
-      if (n != kNone && is_old(n)) continue;
+      if (n != kNone && flip.Replaces(n)) continue;
       outer[num_outer++] = Outer{FaceKey(tet_[o], f), n};
     }
   }
+  const uint32_t component = component_[flip.old_tets[0]];
   for (int i = 0; i < flip.num_old; ++i) {
     const uint32_t o = flip.old_tets[i];
+    Save(o, journal);
     alive_[o] = 0;
     ++version_[o];
     nbr_[o] = {kNone, kNone, kNone, kNone};
   }
   // Reuse the old slots (LIFO: the last replaced first).
   for (int i = 0; i < flip.num_old; ++i) free_.push_back(flip.old_tets[i]);
-  std::array<uint32_t, 4> slots{};
+  std::array<uint32_t, kMaxNew> slots{};
   for (int i = 0; i < flip.num_new; ++i) {
-    slots[i] = Allocate();
+    slots[i] = Allocate(journal);
     tet_[slots[i]] = flip.new_tets[i];
     quality_[slots[i]] = flip.new_quality[i];
+    component_[slots[i]] = component;
     nbr_[slots[i]] = {kNone, kNone, kNone, kNone};
   }
   for (int i = 0; i < flip.num_new; ++i) {
     const uint32_t s = slots[i];
     for (int f = 0; f < 4; ++f) {
+      if (nbr_[s][f] != kNone) continue;  // linked from the other side already
       const Tri key = FaceKey(tet_[s], f);
-      uint32_t across = kNone;
       bool inner = false;
       for (int j = 0; j < flip.num_new && !inner; ++j) {
         if (j == i) continue;
-        const int g = [&] {
-          for (int h = 0; h < 4; ++h) {
-            if (FaceKey(tet_[slots[j]], h) == key) return h;
+        for (int h = 0; h < 4; ++h) {
+          if (FaceKey(tet_[slots[j]], h) == key) {
+            nbr_[s][f] = slots[j];
+            nbr_[slots[j]][h] = s;
+            inner = true;
+            break;
           }
-          return -1;
-        }();
-        if (g >= 0) {
-          across = slots[j];
-          inner = true;
         }
       }
-      if (!inner) {
-        for (int o = 0; o < num_outer; ++o) {
-          if (outer[o].key != key) continue;
-          across = outer[o].tet;
-          if (across != kNone) {
-            for (int h = 0; h < 4; ++h) {
-              if (FaceKey(tet_[across], h) == key) nbr_[across][h] = s;
+      if (inner) continue;
+      for (int o = 0; o < num_outer; ++o) {
+        if (outer[o].key != key) continue;
+        const uint32_t across = outer[o].tet;
+        nbr_[s][f] = across;
+        if (across != kNone) {
+          for (int h = 0; h < 4; ++h) {
+            if (FaceKey(tet_[across], h) == key) {
+              Save(across, journal);
+              nbr_[across][h] = s;
             }
           }
-          break;
         }
+        break;
       }
-      nbr_[s][f] = across;
     }
     created->push_back(s);
   }
-  switch (flip.type) {
-    case Flip::k23: ++stats_->flips_23; break;
-    case Flip::k32: ++stats_->flips_32; break;
-    case Flip::k44: ++stats_->flips_44; break;
+}
+
+void FlipMesh::Count(const Flip& flip) {
+  switch (flip.ring) {
+    case 0: ++stats_->flips_23; break;
+    case 3: ++stats_->flips_32; break;
+    case 4: ++stats_->flips_44; break;
+    default: ++stats_->flips_edge_removal; break;
   }
+}
+
+bool FlipMesh::Search(uint32_t t, int depth, double floor, std::vector<Flip>* seq, double* score) {
+  Flip last;
+  if (BestFlip(t, floor, &last)) {
+    seq->assign(1, last);
+    *score = last.new_min;
+    return true;
+  }
+  if (depth <= 1) return false;
+  // Nearby tets: the face neighbours of t and the tets around its edges.
+  std::vector<uint32_t> near;
+  for (int f = 0; f < 4; ++f) {
+    if (nbr_[t][f] != kNone) near.push_back(nbr_[t][f]);
+  }
+  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  for (const auto& ij : kEdges) {
+    std::array<uint32_t, kMaxRing> ring_tets{}, u{};
+    int n = 0;
+    if (Ring(t, tet_[t][ij[0]], tet_[t][ij[1]], kMaxRing, &ring_tets, &u, &n)) {
+      for (int k = 0; k < n; ++k) {
+        if (ring_tets[k] != t) near.push_back(ring_tets[k]);
+      }
+    }
+  }
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  // Try every first flip F1 that leaves t alone and makes only tets better
+  // than t, then search again from there; keep the sequence with the best
+  // worst new quality. The sequence replaces t and the tets of its flips by
+  // tets all better than t: the worst quality of the tets it touches strictly
+  // rises, as for one flip.
+  bool found = false;
+  std::vector<Flip> rest;
+  std::vector<uint32_t> scratch;
+  for (uint32_t s : near) {
+    ForEachFlip(s, [&](const Flip& f1) {
+      if (f1.Replaces(t) || !(f1.new_min > floor)) return;
+      if (found && !(f1.new_min > *score)) return;  // cannot beat the best sequence
+      Journal journal;
+      journal.num_slots = tet_.size();
+      journal.free_size = free_.size();
+      const size_t keep = std::min<size_t>(free_.size(), kMaxNew + kMaxRing);
+      journal.free_tail.assign(free_.end() - static_cast<std::ptrdiff_t>(keep), free_.end());
+      scratch.clear();
+      Apply(f1, &scratch, &journal);
+      double rest_score = -kInf;
+      if (Search(t, depth - 1, floor, &rest, &rest_score)) {
+        const double total = std::min(f1.new_min, rest_score);
+        if (!found || total > *score) {
+          *score = total;
+          seq->assign(1, f1);
+          seq->insert(seq->end(), rest.begin(), rest.end());
+          found = true;
+        }
+      }
+      Undo(journal);
+    });
+  }
+  return found;
 }
 
 void FlipMesh::Run() {
@@ -523,15 +763,33 @@ void FlipMesh::Run() {
       const auto [q, t, ver] = queue_.top();
       queue_.pop();
       if (!alive_[t] || version_[t] != ver) continue;  // replaced since it was queued
-      Flip best;
-      if (!BestFlip(t, &best)) {
-        ++stats_->stuck;
-        continue;
-      }
       created.clear();
-      Apply(best, &created);
+      Flip best;
+      if (BestFlip(t, -kInf, &best)) {
+        Apply(best, &created, nullptr);
+        Count(best);
+      } else {
+        // The deeper search only for tets within the radius-edge bound: the
+        // refiner guarantees it for every tet of a bounded domain, so the
+        // others are exterior tets next to ∂Ω (clipped cells), which the
+        // output drops; searching around them is wasted time.
+        std::vector<Flip> seq;
+        double score = -kInf;
+        if (options_.lookahead_depth < 2 || !(quality_[t].radius_edge <= options_.max_radius_edge) ||
+            !Search(t, static_cast<int>(options_.lookahead_depth), quality_[t].min_dihedral, &seq, &score)) {
+          ++stats_->stuck;
+          continue;
+        }
+        for (const Flip& f : seq) {
+          Apply(f, &created, nullptr);
+          Count(f);
+        }
+        ++stats_->lookahead_sequences;
+      }
       ++flips_in_pass;
-      for (uint32_t s : created) Push(s);
+      for (uint32_t s : created) {
+        if (alive_[s]) Push(s);
+      }
       if (stats_->flips() >= cap) {
         stats_->hit_flip_cap = true;
         break;
@@ -595,11 +853,14 @@ void SliverStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("sliver.flips_23", static_cast<double>(flips_23));
   out->Set("sliver.flips_32", static_cast<double>(flips_32));
   out->Set("sliver.flips_44", static_cast<double>(flips_44));
+  out->Set("sliver.flips_edge_removal", static_cast<double>(flips_edge_removal));
+  out->Set("sliver.lookahead_sequences", static_cast<double>(lookahead_sequences));
   out->Set("sliver.passes", static_cast<double>(passes));
   out->Set("sliver.candidates", static_cast<double>(candidates));
   out->Set("sliver.rejected_orientation", static_cast<double>(rejected_orientation));
   out->Set("sliver.rejected_constraint", static_cast<double>(rejected_constraint));
   out->Set("sliver.rejected_radius_edge", static_cast<double>(rejected_radius_edge));
+  out->Set("sliver.rejected_volume", static_cast<double>(rejected_volume));
   out->Set("sliver.rejected_no_gain", static_cast<double>(rejected_no_gain));
   out->Set("sliver.stuck", static_cast<double>(stuck));
   out->Set("sliver.hit_flip_cap", hit_flip_cap ? 1 : 0);

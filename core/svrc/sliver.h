@@ -1,7 +1,7 @@
-// Sliver removal by topological flips (2-3, 3-2, 4-4) on the final
-// tetrahedralization, before labelling: the "sliver removal" extension of thesis
-// §6.2.1, phase 1 (no vertex is moved or added). Decisions: docs/svrc-output.md
-// "Sliver removal".
+// Sliver removal by topological flips (2-3, and edge removal: 3-2, 4-4, 5-6,
+// 6-8, 7-10) on the final tetrahedralization, before labelling: the "sliver
+// removal" extension of thesis §6.2.1, phase 1 (no vertex is moved or added).
+// Decisions and measurements: docs/svrc-output.md "Sliver removal".
 //
 // Why: Delaunay refinement with a radius-edge bound leaves slivers — four
 // nearly coplanar, nearly cocircular vertices, radius-edge fine, dihedral angles
@@ -10,8 +10,10 @@
 // the tet between two "diagonals" of a flat quadrilateral; a flip that retriangulates
 // its neighbourhood often removes it (Joe, "Construction of three-dimensional
 // improved-quality triangulations using local transformations", SIAM J. Sci.
-// Comput. 1995; Klingner & Shewchuk, "Aggressive tetrahedral mesh improvement",
-// IMR 2007: hill-climbing on the worst quality of the tets a flip replaces).
+// Comput. 1995; Shewchuk, "Two discrete optimization algorithms for the
+// topological improvement of tetrahedral meshes", 2002 (edge removal);
+// Klingner & Shewchuk, "Aggressive tetrahedral mesh improvement", IMR 2007:
+// hill-climbing on the worst quality of the tets an operation replaces).
 #pragma once
 
 #include <array>
@@ -26,9 +28,10 @@
 
 namespace svrc::refine {
 
-// Default target when MeshParams::min_dihedral is not set (docs/svrc-output.md
-// "Sliver removal": what flips reach on the corpus and the generated families).
-inline constexpr double kDefaultSliverTargetDeg = 5.0;
+// Default target (docs/svrc-output.md "Sliver removal": flips reach 15° on
+// most of the corpus and the generated families at a small cost; where they
+// cannot, the worst tet still improves as far as the rules allow).
+inline constexpr double kDefaultSliverTargetDeg = 15.0;
 
 struct SliverOptions {
   // A tet is "bad" (queued) when its smallest dihedral angle is below this.
@@ -37,10 +40,25 @@ struct SliverOptions {
   // largest ratio among the tets the flip replaces): the refiner's guarantee
   // (radius-edge ≤ τ/2) survives the pass. +inf: no bound.
   double max_radius_edge = 2.0;
+  // No new tet may be larger (volume) than the largest input tet of its
+  // component (the tets connected to it across non-constrained faces — the
+  // labelling's components, docs/svrc-output.md §2). A flip never crosses a
+  // constrained face, so components survive the pass unchanged: every
+  // per-region max-volume bound the input meets (size events,
+  // MeshParams::max_volume) stays met without the pass knowing the regions.
+  // Off by default: it costs quality where no bound asks for it (small
+  // components whose largest tet is what a 3-2 flip must exceed).
+  bool keep_max_volume = false;
   // Passes over the bad tets; a pass re-queues every bad tet left by the
   // previous one (flips elsewhere may have unblocked it). Stops early when a
   // pass flips nothing.
   uint32_t max_passes = 4;
+  // For a bad tet no single flip improves: search sequences of up to
+  // lookahead_depth flips — flips of nearby tets that create only tets better
+  // than it, then an improving flip of the bad tet — and apply the best one.
+  // 1: single flips only. Only for bad tets within max_radius_edge (the
+  // others are ∂Ω's exterior, dropped by the labelling).
+  uint32_t lookahead_depth = 2;
   // Safety cap on the number of flips (0: 4 × the number of tets + 1000). Every
   // flip strictly raises the worst quality of the tets it replaces, so the
   // pass terminates anyway; the cap bounds the time.
@@ -57,17 +75,22 @@ struct SliverStats {
   double max_dihedral_before = 0, max_dihedral_after = 0;  // degrees, worst tet
   double max_radius_edge_before = 0, max_radius_edge_after = 0;
   uint64_t flips_23 = 0, flips_32 = 0, flips_44 = 0;
+  uint64_t flips_edge_removal = 0;  // removals of an edge with 5..7 tets around it
+  uint64_t lookahead_sequences = 0; // flip sequences found by the lookahead (flips counted above)
   uint64_t passes = 0;
-  uint64_t candidates = 0;            // flips evaluated (legal or not)
-  uint64_t rejected_orientation = 0;  // a new tet not strictly positive (exact Orient3d)
+  uint64_t candidates = 0;            // 2-3 flips and edge removals evaluated (legal or not)
+  // No candidate tet strictly positive (exact Orient3d) — for an edge removal:
+  // no triangulation of the ring made only of positive tets within the bounds.
+  uint64_t rejected_orientation = 0;
   uint64_t rejected_constraint = 0;   // would remove a constrained face or edge
   uint64_t rejected_radius_edge = 0;  // a new tet over the radius-edge bound
+  uint64_t rejected_volume = 0;       // a new tet larger than its component's largest
   uint64_t rejected_no_gain = 0;      // legal, but no better than the tets it replaces
   uint64_t stuck = 0;                 // bad tets no flip improved (summed over passes)
   bool hit_flip_cap = false;
   double seconds = 0;
 
-  uint64_t flips() const { return flips_23 + flips_32 + flips_44; }
+  uint64_t flips() const { return flips_23 + flips_32 + flips_44 + flips_edge_removal; }
   void ExportTo(mesh::MeshStats* out) const;
 };
 
@@ -96,14 +119,19 @@ struct SliverResult {
 
 // Improves the worst tets by flips: a priority queue of bad tets, worst first
 // (ties by slot index); for the popped tet every 2-3 flip across one of its
-// faces and every 3-2 / 4-4 flip removing one of its edges (edge of degree 3 /
-// 4 with a closed ring) is evaluated; the legal one with the best new worst
-// quality is applied if that is strictly better than the worst tet it replaces
-// and no new tet exceeds the radius-edge bound. Legality is exact: every new
-// tet strictly positive by geom::Orient3d, no constrained face or edge removed.
-// Quality (smallest dihedral angle, radius-edge ratio) is floating point,
-// computed from the vertices in sorted-id order so that a tet's value does not
-// depend on how it was written. Deterministic.
+// faces and the removal of each of its edges whose ring is closed with 3..7
+// tets (the best triangulation of the ring polygon, by dynamic programming:
+// 3-2, 4-4, 5-6, 6-8, 7-10) is evaluated; the legal one with the best new
+// worst quality is applied if that is strictly better than the worst tet it
+// replaces and no new tet exceeds the radius-edge (and volume) bound. If none
+// is, a depth-limited search (lookahead_depth) looks for flips of nearby tets
+// that create only tets better than the bad one and after which it has an
+// improving flip. Legality is exact: every new tet strictly positive by
+// geom::Orient3d, no constrained face or edge removed. Quality (smallest
+// dihedral angle, radius-edge ratio, volume) is floating point, computed from
+// the vertices in sorted-id order so that a tet's value does not depend on how
+// it was written; every applied operation strictly raises the worst quality of
+// the tets it touches, so the pass cannot cycle. Deterministic.
 // INVALID_ARGUMENT: an id out of range, a repeated vertex, a tet not strictly
 // positive, a face in three tets, a constrained face or edge that is not in the
 // mesh. INTERNAL: a constraint lost at the end (a bug).

@@ -231,6 +231,58 @@ TEST(Sliver, FourFourFlipInOctahedron) {
   EXPECT_EQ(r->stats.bad_after, 0u);
 }
 
+// Five tets around the edge pq (vertices 0, 1), found like the octahedron:
+// (p, q, u_i, u_i+1) has a 4° dihedral angle; the best retriangulation of
+// the 5-ring (edge removal, 5 tets -> 6, by the dynamic programme over the
+// ring polygon) raises the worst to 19.5°. Single flips only (no lookahead).
+TEST(Sliver, EdgeRemovalOfAFiveRing) {
+  const std::vector<Vec3> pos = {{0.036, 0.06, 1.135},  {0.141, 0.012, -0.71},  {1.06, -0.03, 0.1925},
+                                 {0.7, -0.62, -0.05},   {-0.56, 0.6, 0.0425},   {-0.18, 1.42, 0.1725},
+                                 {0.63, 0.76, -0.185}};
+  std::vector<Tet> tets;
+  for (uint32_t i = 0; i < 5; ++i) {
+    const Tet t{0, 1, 2 + i, 2 + (i + 1) % 5};
+    ASSERT_GT(geom::Orient3d(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]), 0);
+    tets.push_back(t);
+  }
+  ASSERT_LT(WorstDihedral(pos, tets), 4.0);
+  SliverOptions opt;
+  opt.target_min_dihedral_deg = 10;
+  opt.lookahead_depth = 1;
+  SliverInput in{pos, tets, {}, {}};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips_edge_removal, 1u);
+  EXPECT_EQ(r->stats.flips(), 1u);
+  ASSERT_EQ(r->tets.size(), 6u);
+  EXPECT_FALSE(HasEdge(r->tets, {0, 1}));
+  EXPECT_EQ(CheckedBoundary(pos, r->tets), CheckedBoundary(pos, tets));
+  EXPECT_NEAR(Volume(pos, r->tets), Volume(pos, tets), 1e-14);
+  EXPECT_GT(WorstDihedral(pos, r->tets), 19.0);
+  // The same ring with the edge constrained: nothing to do.
+  const std::vector<Edge> edges = {{0, 1}};
+  SliverInput pinned{pos, tets, {}, edges};
+  r = RemoveSlivers(pinned, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);
+  EXPECT_EQ(r->tets, tets);
+}
+
+// keep_max_volume: the 3-2 flip of the three-ring makes two tets of half the
+// total volume each, larger than the largest of the three (its component is
+// the whole ring), so it is refused.
+TEST(Sliver, KeepMaxVolumeRefusesLargerTets) {
+  ThreeRing ring;
+  SliverOptions opt;
+  opt.keep_max_volume = true;
+  SliverInput in{ring.pos, ring.tets, {}, {}};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips(), 0u);
+  EXPECT_GE(r->stats.rejected_volume, 1u);
+  EXPECT_EQ(r->tets, ring.tets);
+}
+
 TEST(Sliver, RejectsBadInput) {
   ThreeRing ring;
   {
@@ -274,17 +326,19 @@ TEST(Sliver, PipelineFormTakesChainsAsEdges) {
   EXPECT_EQ(r->stats.flips_32, 1u);
 }
 
-// Random Delaunay meshes (core/delaunay/point_set.h), with every 5th interior
-// face and every 7th edge constrained: after the pass the tets are a proper
+// Random Delaunay meshes (core/delaunay/point_set.h: 200 uniform points and a
+// jittered grid, ~1900 tets), with every 5th interior face and every 7th edge
+// constrained: after the pass the tets are a proper
 // tetrahedralization of the same union with the same boundary, every
 // constraint is still there, the worst dihedral is not worse, no tet is above
 // max(bound, the input's worst radius-edge), and two runs give the same tets.
 TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
+  uint64_t sequences = 0;
   for (uint64_t seed : {1u, 2u, 3u}) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(0, 1);
     std::vector<Vec3> pos;
-    for (int i = 0; i < 400; ++i) pos.push_back({u(rng), u(rng), u(rng)});
+    for (int i = 0; i < 200; ++i) pos.push_back({u(rng), u(rng), u(rng)});
     // A jittered grid layer: near-cospherical groups make Delaunay slivers.
     for (int i = 0; i < 6; ++i) {
       for (int j = 0; j < 6; ++j) {
@@ -323,7 +377,7 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
       max_re = std::max(max_re, mesh::ComputeTetQuality(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]).radius_edge);
     }
     SliverOptions opt;
-    opt.target_min_dihedral_deg = 15;
+    opt.target_min_dihedral_deg = 10;
     opt.max_radius_edge = 2;
     SliverInput in{pos, tets, faces, edges};
     absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
@@ -351,7 +405,9 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
     absl::StatusOr<SliverResult> again = RemoveSlivers(in, opt);
     ASSERT_TRUE(again.ok());
     EXPECT_EQ(again->tets, r->tets);
+    sequences += s.lookahead_sequences;
   }
+  EXPECT_GT(sequences, 0u);  // the depth-2 search was exercised (and kept every invariant above)
 }
 
 }  // namespace
