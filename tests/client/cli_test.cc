@@ -68,6 +68,41 @@ TEST_F(CliTest, LocalAndRemoteOutputsAreByteIdentical) {
   fs::remove_all(dir);
 }
 
+// The same for a PLC (SVRC refinement, facets and regions in the output; issue
+// #5): `svrc mesh` twice and `svrc submit --watch` agree byte for byte.
+TEST_F(CliTest, PlcLocalAndRemoteOutputsAreByteIdentical) {
+  ASSERT_TRUE(server_->ok());
+  const std::string dir = testing::MakeTempDir("cli_plc_identity");
+  const std::string input = testing::CorpusPath("b_internal/box_internal_facet.poly");
+  for (const char* ext : {".node", ".vtu", ".svrc"}) {
+    SCOPED_TRACE(ext);
+    std::map<std::string, std::string> outputs[3];
+    for (int run = 0; run < 3; ++run) {
+      const std::string out_dir = dir + "/run" + std::to_string(run) + ext;
+      fs::create_directories(out_dir);
+      testing::CommandResult r =
+          run < 2 ? RunSvrc({"mesh", input, "-o", out_dir + "/out" + ext, "--quiet"})
+                  : RunSvrc({"submit", input, "--server", server_->address(), "--watch", "-o",
+                             out_dir + "/out" + ext});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      outputs[run] = DirFiles(out_dir);
+    }
+    ASSERT_FALSE(outputs[0].empty());
+    for (int run = 1; run < 3; ++run) {
+      EXPECT_EQ(outputs[run].size(), outputs[0].size()) << "run " << run;
+      for (const auto& [name, bytes] : outputs[0]) {
+        ASSERT_TRUE(outputs[run].count(name)) << name << " missing in run " << run;
+        EXPECT_TRUE(bytes == outputs[run][name]) << name << " differs in run " << run << " ("
+                                                 << bytes.size() << " vs " << outputs[run][name].size()
+                                                 << " bytes)";
+      }
+    }
+  }
+  // A PLC's .node output has its boundary faces (markers) next to it.
+  EXPECT_TRUE(fs::exists(dir + "/run0.node/out.face"));
+  fs::remove_all(dir);
+}
+
 TEST_F(CliTest, SubmitPrintsTheJobIdThenGetListAndHealthWork) {
   ASSERT_TRUE(server_->ok());
   const std::string dir = testing::MakeTempDir("cli_submit");

@@ -1,14 +1,15 @@
 // End to end against a real svrc-server process on a free loopback port,
 // driven by the C++ client library (client/remote_client.h): submit → watch →
 // fetch → decode, progress events, cancel, N workers, queue full, idempotent
-// resubmission, deadlines, a broken PLC, resumable fetch, a 50 MB upload,
-// SIGTERM. Point-set jobs make real meshes; PLC jobs must end SUCCEEDED or
+// resubmission, deadlines, a broken PLC, a PLC's output byte-identical across
+// runs and worker counts, resumable fetch, a 50 MB upload, SIGTERM. Point-set jobs make real meshes; PLC jobs must end SUCCEEDED or
 // FAILED/UNIMPLEMENTED (until PLC meshing lands) — never anything else.
 #include <signal.h>
 
 #include <chrono>
 #include <filesystem>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "client/mesh_job.h"
@@ -299,6 +300,71 @@ TEST(ServiceTest, PlcJobSucceedsOrIsUnimplementedNeverAnythingElse) {
     EXPECT_EQ(done->state(), v1::FAILED);
     EXPECT_EQ(done->error().code(), static_cast<int>(grpc::StatusCode::UNIMPLEMENTED))
         << done->error().message();
+  }
+}
+
+// Issue #5: byte-identical output across runs and worker counts, for PLCs
+// (SVRC refinement with facet meshes, not only a point set's Delaunay): the
+// same request meshed twice locally (client/mesh_job.h, the workers' own
+// pipeline), then on servers with 1 and 2 workers, each input submitted twice
+// at once (with 2 workers two copies run concurrently on different threads).
+std::string LocalContainerFor(const v1::SubmitJobRequest& r) {
+  absl::StatusOr<plc::InputFormat> format = api::FormatFromProto(r.file().format());
+  EXPECT_TRUE(format.ok()) << format.status();
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(r.file().data(), *format, r.file().name());
+  EXPECT_TRUE(plc.ok()) << plc.status();
+  absl::StatusOr<mesh::TetMesh> mesh = cli::RunMeshing(*plc, cli::MeshOptions(), nullptr, nullptr);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  if (!mesh.ok()) return "";
+  absl::StatusOr<std::string> bytes = codec::EncodeTetMesh(*mesh, codec::EncodeOptions());
+  EXPECT_TRUE(bytes.ok()) << bytes.status();
+  return bytes.ok() ? *bytes : "";
+}
+
+TEST(ServiceTest, PlcOutputIsByteIdenticalAcrossRunsAndWorkerCounts) {
+  std::vector<v1::SubmitJobRequest> requests;
+  std::vector<std::string> local;
+  for (const char* file : {"b_internal/box_internal_facet.poly", "e_spread/tiny_cube_in_box.poly"}) {
+    SCOPED_TRACE(file);
+    absl::StatusOr<v1::SubmitJobRequest> r = cli::RequestForFile(testing::CorpusPath(file));
+    ASSERT_TRUE(r.ok()) << r.status();
+    const std::string a = LocalContainerFor(*r), b = LocalContainerFor(*r);
+    ASSERT_FALSE(a.empty());
+    EXPECT_TRUE(a == b) << "two local runs differ";
+    absl::StatusOr<mesh::TetMesh> mesh = codec::DecodeTetMesh(a);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    EXPECT_GT(mesh->num_tets(), 0u);
+    EXPECT_FALSE(mesh->triangles.empty());  // the PLC's facets are in the output
+    requests.push_back(*r);
+    local.push_back(a);
+  }
+  for (const char* workers : {"--workers=1", "--workers=2"}) {
+    SCOPED_TRACE(workers);
+    ServerProcess server({workers});
+    ASSERT_TRUE(server.ok());
+    RemoteClient c(server.address());
+    std::vector<std::pair<size_t, std::string>> jobs;  // (input, job id)
+    for (int copy = 0; copy < 2; ++copy) {
+      for (size_t i = 0; i < requests.size(); ++i) {
+        absl::StatusOr<v1::Job> job = c.Submit(requests[i]);  // a fresh request id each time
+        ASSERT_TRUE(job.ok()) << job.status();
+        jobs.emplace_back(i, job->job_id());
+      }
+    }
+    std::set<std::string> ids;
+    for (const auto& [i, id] : jobs) {
+      ids.insert(id);
+      absl::StatusOr<v1::Job> done = c.Watch(id, nullptr);
+      ASSERT_TRUE(done.ok()) << done.status();
+      ASSERT_EQ(done->state(), v1::SUCCEEDED) << done->error().message();
+      absl::StatusOr<cli::FetchedResult> result = c.Fetch(id);
+      ASSERT_TRUE(result.ok()) << result.status();
+      EXPECT_EQ(result->sha256, done->result().sha256());
+      EXPECT_TRUE(result->bytes == local[i])
+          << "input " << i << " job " << id << ": " << result->bytes.size() << " vs " << local[i].size()
+          << " bytes locally";
+    }
+    EXPECT_EQ(ids.size(), jobs.size());  // four jobs, not deduplicated
   }
 }
 
