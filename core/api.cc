@@ -223,10 +223,10 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   }
   mesh::MeshStats stats;
   refined->stats.ExportTo(&stats);
-  // Sliver removal by flips (core/svrc/sliver.h; docs/svrc-output.md): keeps faces, segments, radius-edge, volumes.
+  // Sliver removal by flips (core/svrc/sliver.h; docs/svrc-output.md §7): keeps facet triangles, segment pieces,
+  // radius-edge <= params.radius_edge and (if any is set) max volumes; default target kDefaultSliverTargetDeg.
   refine::SliverOptions sliver;
   sliver.max_radius_edge = params.radius_edge;
-  if (getenv("SVRC_SLIVER_TARGET")) sliver.target_min_dihedral_deg = atof(getenv("SVRC_SLIVER_TARGET"));  // TEMP
   sliver.keep_max_volume = params.max_volume > 0 || std::any_of(plc.regions.begin(), plc.regions.end(),
                                                                  [](const plc::RegionSeed& r) { return r.max_volume > 0; });
   absl::StatusOr<refine::SliverResult> flipped = refine::RemoveSlivers(
