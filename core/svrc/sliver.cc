@@ -227,8 +227,12 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
         if (v[i] == v[j]) return absl::InvalidArgumentError(absl::StrCat("sliver: tet ", t, " repeats vertex ", v[i]));
       }
     }
-    if (geom::Orient3d(pos_[v[0]], pos_[v[1]], pos_[v[2]], pos_[v[3]]) <= 0) {
-      return absl::InvalidArgumentError(absl::StrCat("sliver: tet ", t, " is not positively oriented"));
+    // Exactly flat tets (Orient3d = 0) are accepted: a Delaunay kernel with
+    // symbolic perturbation can leave them where points are exactly coplanar
+    // (∂Ω). A flip only ever replaces them by strictly positive tets with the
+    // same boundary, which still tile the same region.
+    if (geom::Orient3d(pos_[v[0]], pos_[v[1]], pos_[v[2]], pos_[v[3]]) < 0) {
+      return absl::InvalidArgumentError(absl::StrCat("sliver: tet ", t, " is negatively oriented"));
     }
     quality_[t] = Measure(pos_, v);
   }

@@ -96,8 +96,9 @@ struct SliverStats {
 
 struct SliverInput {
   // Vertex positions in the coordinates the tets are positively oriented in
-  // (the mesher's normalised ones), the tets (Orient3d(p0,p1,p2,p3) > 0, each
-  // face in at most two tets).
+  // (the mesher's normalised ones), the tets (Orient3d(p0,p1,p2,p3) > 0, or
+  // = 0 for a flat tet a symbolically perturbed Delaunay kernel may leave on
+  // exactly coplanar points; each face in at most two tets).
   std::span<const geom::Vec3> positions;
   std::span<const std::array<uint32_t, 4>> tets;
   // Triangles that must stay faces (in-facet triangles; any vertex order) and
@@ -108,7 +109,8 @@ struct SliverInput {
 };
 
 struct SliverResult {
-  // Positively oriented, the same union and the same boundary faces as the
+  // Positively oriented (flat input tets that no flip replaced stay as they
+  // were), the same union and the same boundary faces as the
   // input (flips happen only inside closed neighbourhoods: no hull face or
   // hull edge is ever removed), every constrained face a face and every
   // constrained edge an edge. Surviving input tets keep their vertex order;
@@ -132,8 +134,8 @@ struct SliverResult {
 // the vertices in sorted-id order so that a tet's value does not depend on how
 // it was written; every applied operation strictly raises the worst quality of
 // the tets it touches, so the pass cannot cycle. Deterministic.
-// INVALID_ARGUMENT: an id out of range, a repeated vertex, a tet not strictly
-// positive, a face in three tets, a constrained face or edge that is not in the
+// INVALID_ARGUMENT: an id out of range, a repeated vertex, a negatively
+// oriented tet, a face in three tets, a constrained face or edge that is not in the
 // mesh. INTERNAL: a constraint lost at the end (a bug).
 absl::StatusOr<SliverResult> RemoveSlivers(const SliverInput& input, const SliverOptions& options);
 

@@ -74,10 +74,11 @@ Tri Sorted(Tri t) {
 // Checks that `tets` is a proper tetrahedralization (every tet strictly
 // positive by exact Orient3d; every face in one tet, or in two with opposite
 // orientations) and returns its boundary faces (oriented, canonical, sorted).
-std::vector<Tri> CheckedBoundary(const std::vector<Vec3>& pos, const std::vector<Tet>& tets) {
+std::vector<Tri> CheckedBoundary(const std::vector<Vec3>& pos, const std::vector<Tet>& tets,
+                                 bool allow_flat = false) {
   std::map<Tri, std::vector<Tri>> by_key;  // sorted key -> oriented faces
   for (const Tet& t : tets) {
-    EXPECT_GT(geom::Orient3d(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]), 0)
+    EXPECT_GE(geom::Orient3d(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]), allow_flat ? 0 : 1)
         << t[0] << " " << t[1] << " " << t[2] << " " << t[3];
     for (const Tri& f : OrientedFaces(t)) by_key[Sorted(f)].push_back(f);
   }
@@ -150,6 +151,27 @@ TEST(Sliver, ThreeTwoFlipRemovesSliverBetweenTwoTets) {
   EXPECT_EQ(r->stats.tets_after, 2u);
   EXPECT_LT(r->stats.min_dihedral_before, 2.0);
   EXPECT_DOUBLE_EQ(r->stats.min_dihedral_after, WorstDihedral(ring.pos, r->tets));
+}
+
+// An exactly flat tet (Orient3d = 0: u1 = (−1, 0, 0) is in the plane of p, q,
+// u0), as a Delaunay kernel with symbolic perturbation can leave on coplanar
+// points: accepted, and the 3-2 flip replaces it by two positive tets.
+TEST(Sliver, ExactlyFlatTetIsAcceptedAndReplaced) {
+  const std::vector<Vec3> pos = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, -1, 0}};
+  const Tet a = Positive(pos, {0, 1, 3, 4}), b = Positive(pos, {0, 1, 4, 2});
+  // The flat tet in the orientation its neighbours imply (the ring's order).
+  const Tet flat = a == Tet{0, 1, 3, 4} ? Tet{0, 1, 2, 3} : Tet{0, 1, 3, 2};
+  ASSERT_EQ(geom::Orient3d(pos[flat[0]], pos[flat[1]], pos[flat[2]], pos[flat[3]]), 0);
+  const std::vector<Tet> tets = {flat, a, b};
+  SliverInput in{pos, tets, {}, {}};
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, SliverOptions{});
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.flips_32, 1u);
+  ASSERT_EQ(r->tets.size(), 2u);
+  EXPECT_EQ(CheckedBoundary(pos, r->tets), CheckedBoundary(pos, tets, /*allow_flat=*/true));
+  EXPECT_NEAR(Volume(pos, r->tets), Volume(pos, tets), 1e-15);
+  EXPECT_EQ(r->stats.min_dihedral_before, 0.0);
+  EXPECT_GT(r->stats.min_dihedral_after, 40.0);
 }
 
 TEST(Sliver, ConstrainedEdgeBlocksTheFlip) {
