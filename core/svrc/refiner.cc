@@ -117,6 +117,20 @@ class Refiner {
   // A gap ball of M_Ω (Skinny₃ / Unresolved₃ of cell v): warp, else yield,
   // else insert the centre.
   absl::Status DestroyOmega(VertexId v);
+  // Figure 3.4 for the gap ball B(c, r) of M_Ω, c in the cell of v.
+  absl::Status DestroyOmegaAt(const Vec3& c, double r, TetId hint, VertexId v);
+ public:
+  // Near-flat tets of M_Ω (6|V| ≤ 10^−6·ℓ³, ℓ the longest edge), which the
+  // flip pass cannot always remove (four nearly cocircular coplanar points
+  // whose both diagonals are locked by facets): one lying on a facet has an
+  // in-facet triangle of that facet among its faces, whose ball is enqueued
+  // Encroached (its circumcentre breaks the cocircularity); one off the
+  // facets gets the centroid of its vertices as a gap ball (inside its
+  // circumsphere: any sphere through the near-circle contains its disk).
+  // Tets with all vertices on ∂Ω are left (dropped from the output).
+  // Returns whether anything was done (then Run() again).
+  absl::StatusOr<bool> BreakFlatTets();
+ private:
   // A gap ball of segment mesh `seg` whose centre is the midpoint of the piece
   // starting at local vertex u (Encroached₁ of the piece ball, Skinny₁).
   absl::Status DestroySegmentPiece(uint32_t seg, uint32_t u);
@@ -932,8 +946,13 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
   // cell: ⟨(farthest corner of V(v) ∩ Ω, R_v), Ω⟩; CD(B) = CD(c) = (3,3).
   const CellSize s = (last_size_vertex_ == v && last_size_gen_ == omega_.CellGeneration(v)) ? last_size_
                                                                                            : omega_.Size(v);
-  const Vec3 c = s.corner;
-  const double r = s.outradius;
+  return DestroyOmegaAt(s.corner, s.outradius, s.hint, v);
+}
+
+absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, VertexId v) {
+  struct {
+    TetId hint;
+  } s{cell_hint};
   const Cd cd_ball = kCdSpace;
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
@@ -1429,6 +1448,104 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   return any;
 }
 
+absl::StatusOr<bool> Refiner::BreakFlatTets() {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  const geom::Box3& cube = omega_.cube();
+  auto on_box = [&](const Vec3& p, int axis, int side) { return p[axis] == (side ? cube.hi[axis] : cube.lo[axis]); };
+  // The facets a point lies on (input points, segment points, facet points).
+  auto facets_of = [&](PointId p, std::vector<uint32_t>* out) {
+    out->clear();
+    const FeatureId parent = points_.Parent(p);
+    if (p.value() < num_input_) {
+      *out = point_facets_[p.value()];
+    } else if (features_.Dim(parent) == 1) {
+      *out = seg_facets_[features_.Index(parent)];
+    } else if (features_.Dim(parent) == 2) {
+      out->push_back(features_.Index(parent));
+    }
+  };
+  std::vector<Vec3> centroids;
+  std::vector<BallId> balls;
+  std::vector<uint32_t> fa, fb;
+  for (TetId t : dt.FiniteTets()) {
+    std::array<Vec3, 4> x;
+    std::array<PointId, 4> q;
+    for (int k = 0; k < 4; ++k) {
+      x[k] = dt.Point(dt.TetVertex(t, k));
+      q[k] = omega_.PointOf(dt.TetVertex(t, k));
+    }
+    const double vol6 = std::fabs(geom::Dot(x[1] - x[0], geom::Cross(x[2] - x[0], x[3] - x[0])));
+    double l2 = 0;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) l2 = std::max(l2, geom::Dist2(x[i], x[j]));
+    }
+    if (vol6 > 1e-6 * l2 * std::sqrt(l2)) continue;
+    bool boxed = false;
+    for (int axis = 0; axis < 3 && !boxed; ++axis) {
+      for (int side = 0; side < 2 && !boxed; ++side) {
+        boxed = on_box(x[0], axis, side) && on_box(x[1], axis, side) && on_box(x[2], axis, side) &&
+                on_box(x[3], axis, side);
+      }
+    }
+    if (boxed) continue;
+    // A facet containing all four points?
+    facets_of(q[0], &fa);
+    for (int k = 1; k < 4 && !fa.empty(); ++k) {
+      facets_of(q[k], &fb);
+      std::vector<uint32_t> both;
+      for (uint32_t f : fa) {
+        if (std::find(fb.begin(), fb.end(), f) != fb.end()) both.push_back(f);
+      }
+      fa.swap(both);
+    }
+    if (fa.empty()) {
+      centroids.push_back(0.25 * (x[0] + x[1] + x[2] + x[3]));
+      continue;
+    }
+    const uint32_t f = fa.front();
+    const FacetMesh& m = facets_[f];
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<uint32_t, 3> k;
+      int n = 0;
+      bool ok = true;
+      for (int i = 0; i < 4; ++i) {
+        if (i == skip) continue;
+        const uint32_t v2 = points_.VertexIn(q[i], FacetMeshId(f));
+        ok = ok && v2 != PointStore::kNoVertex;
+        k[n++] = v2;
+      }
+      if (!ok) continue;
+      std::vector<TriId2> star;
+      m.dt().Star(VertexId2(k[0]), &star);
+      for (TriId2 tri : star) {
+        int hits = 0;
+        for (int e = 0; e < 3; ++e) {
+          const uint32_t w = m.dt().TriVertex(tri, e).value();
+          hits += (w == k[1]) + (w == k[2]);
+        }
+        if (hits == 2 && m.TriBall(tri).valid()) balls.push_back(m.TriBall(tri));
+      }
+    }
+  }
+  bool any = false;
+  for (BallId b : balls) {
+    if (!balls_.IsAlive(b)) continue;
+    EnqueueEncroached(b);
+    ++stats_.flat_tets_broken;
+    any = true;
+  }
+  for (const Vec3& c : centroids) {
+    const VertexId near = dt.NearestVertex(c);
+    const double r = geom::Dist(dt.Point(near), c);
+    if (!(r > 0)) continue;
+    absl::Status s = DestroyOmegaAt(c, r, dt.VertexTet(near), near);
+    if (!s.ok()) return s;
+    ++stats_.flat_tets_broken;
+    any = true;
+  }
+  return any;
+}
+
 bool Refiner::OmegaHasEdge(PointId a, PointId b) const {
   const uint32_t va = points_.VertexIn(a, kOmegaMesh), vb = points_.VertexIn(b, kOmegaMesh);
   if (va == PointStore::kNoVertex || vb == PointStore::kNoVertex) return false;
@@ -1613,6 +1730,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   }
   out->Set("svrc.buckets_walked", static_cast<double>(buckets_walked));
   out->Set("svrc.size_rounds", static_cast<double>(size_rounds));
+  out->Set("svrc.flat_tets_broken", static_cast<double>(flat_tets_broken));
   out->Set("svrc.tied_balls", static_cast<double>(tied_balls));
   out->Set("svrc.phantom_corners", static_cast<double>(phantom_corners));
   out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
@@ -1711,6 +1829,14 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   }
   if (options.validate_every > 0) {
     s = refiner.CheckInvariants(/*final=*/true);
+    if (!s.ok()) return s;
+  }
+  // Near-flat tets the flip pass cannot remove (BreakFlatTets), a few rounds.
+  for (int round = 0; round < 8; ++round) {
+    absl::StatusOr<bool> more = refiner.BreakFlatTets();
+    if (!more.ok()) return more.status();
+    if (!*more) break;
+    s = refiner.Run();
     if (!s.ok()) return s;
   }
   s = refiner.VerifyConformity();

@@ -66,7 +66,8 @@ struct RefineStats {
   uint64_t phantom_corners = 0;    // clipped cell corners equal to an existing vertex (skipped)
   uint64_t tied_balls = 0;
   uint64_t straddle_yields = 0;
-  uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
+  uint64_t size_rounds = 0;
+  uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};

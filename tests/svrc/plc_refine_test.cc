@@ -47,6 +47,9 @@ void ExpectGoodMesh(const Meshed& m, double radius_edge, const std::string& what
   EXPECT_TRUE(rep.ok()) << what << ": " << rep.Summary();
   const mesh::QualityReport q = mesh::ComputeQuality(m.mesh);
   EXPECT_LE(q.all.radius_edge.max, radius_edge * (1 + 1e-9)) << what;
+  // No flat tets: the flip pass (core/svrc/sliver.h) and BreakFlatTets
+  // (refiner.h) leave none; box_internal_facet.poly had one at 6·10^−6°.
+  EXPECT_GE(q.all.dihedral_deg.min, 1.0) << what;
 }
 
 TEST(PlcRefine, Cube) {
