@@ -1744,26 +1744,41 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.seconds_refine", seconds);
 }
 
+// The input's exact normalisation (§1) and Ω: a cube of side 3·diam centred
+// on the normalised input's box (Definition 35); a single point gets a unit cube.
+struct NormalisedInput {
+  Normalization norm;
+  std::vector<Vec3> points;
+  Vec3 center;
+  double half = 0;
+};
+absl::StatusOr<NormalisedInput> NormaliseInput(std::span<const Vec3> points) {
+  absl::StatusOr<Normalization> norm = ChooseNormalization(points);
+  if (!norm.ok()) return norm.status();
+  NormalisedInput out;
+  out.norm = *norm;
+  out.points.resize(points.size());
+  geom::Box3 box;
+  for (size_t i = 0; i < points.size(); ++i) {
+    out.points[i] = norm->Forward(points[i]);
+    box.Add(out.points[i]);
+  }
+  const double diam = box.Diagonal();
+  out.half = diam > 0 ? 1.5 * diam : 0.5;
+  out.center = box.Center();
+  return out;
+}
+
 absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const Vec3> points,
                                                            std::span<const SegmentInput> segments,
                                                            const RefineOptions& options) {
   if (!(options.tau > 0) || !(options.theta > 0 && options.theta < 1)) {
     return absl::InvalidArgumentError("SVRC: need tau > 0 and 0 < theta < 1");
   }
-  absl::StatusOr<Normalization> norm = ChooseNormalization(points);
-  if (!norm.ok()) return norm.status();
-  std::vector<Vec3> normalised(points.size());
-  geom::Box3 box;
-  for (size_t i = 0; i < points.size(); ++i) {
-    normalised[i] = norm->Forward(points[i]);
-    box.Add(normalised[i]);
-  }
-  // Ω: a cube of side 3·diam centred on the input's box (Definition 35); a
-  // single point gets a unit cube.
-  const double diam = box.Diagonal();
-  const double half = diam > 0 ? 1.5 * diam : 0.5;
-  Refiner refiner(options, *norm, box.Center(), half);
-  absl::Status s = refiner.Initialize(normalised, segments);
+  absl::StatusOr<NormalisedInput> in = NormaliseInput(points);
+  if (!in.ok()) return in.status();
+  Refiner refiner(options, in->norm, in->center, in->half);
+  absl::Status s = refiner.Initialize(in->points, segments);
   if (!s.ok()) return s;
   s = refiner.Run();
   if (!s.ok()) return s;
@@ -1799,18 +1814,10 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   }
   std::vector<Vec3> input(complex.points.size());
   for (size_t i = 0; i < input.size(); ++i) input[i] = complex.points[i].p;
-  absl::StatusOr<Normalization> norm = ChooseNormalization(input);
-  if (!norm.ok()) return norm.status();
-  std::vector<Vec3> normalised(input.size());
-  geom::Box3 box;
-  for (size_t i = 0; i < input.size(); ++i) {
-    normalised[i] = norm->Forward(input[i]);
-    box.Add(normalised[i]);
-  }
-  const double diam = box.Diagonal();
-  const double half = diam > 0 ? 1.5 * diam : 0.5;
-  Refiner refiner(options, *norm, box.Center(), half);
-  absl::Status s = refiner.Setup(complex, normalised);
+  absl::StatusOr<NormalisedInput> in = NormaliseInput(input);
+  if (!in.ok()) return in.status();
+  Refiner refiner(options, in->norm, in->center, in->half);
+  absl::Status s = refiner.Setup(complex, in->points);
   if (!s.ok()) return s;
   s = refiner.Run();
   if (!s.ok()) return s;
