@@ -144,6 +144,21 @@ class Refiner {
   // Encroached event): a segment piece or a facet triangle.
   absl::Status DestroyBall(BallId b);
 
+  // Destroy's choices (Figure 3.4 lines 6 and 13): the warp target with the
+  // lowest CD, then nearest to c, then the lowest point id; the yield ball
+  // with the lowest CD, then the largest, then the lowest id (determinism).
+  bool PreferWarp(BallId b, double d2, BallId warp, double warp_d2) const {
+    if (!warp.valid()) return true;
+    const Cd a = balls_.CdOf(b), w = balls_.CdOf(warp);
+    return a < w || (a == w && (d2 < warp_d2 || (d2 == warp_d2 && balls_.VertexPoint(b) < balls_.VertexPoint(warp))));
+  }
+  bool PreferYield(BallId b, BallId yield) const {
+    if (!yield.valid()) return true;
+    const Cd a = balls_.CdOf(b), y = balls_.CdOf(yield);
+    return a < y || (a == y && (balls_.Radius(b) > balls_.Radius(yield) ||
+                                (balls_.Radius(b) == balls_.Radius(yield) && b < yield)));
+  }
+
   // --- ForceInsert (Figure 3.5) + UpdateLocation (3.6) + PropagateLocation (3.9)
   absl::Status ForceInsertOmega(PointId p, TetId hint);
   absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t);
@@ -867,12 +882,10 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
           // disk's rim was never reached (halving to the last ulp; measured
           // on knife_edge.poly refined through its creases).
           if (d2 > (tri.valid() ? r * r * (1 - 1e-9) : theta_r2)) continue;
-          if (warp.valid()) {
-            const Cd a = balls_.CdOf(b), wc = balls_.CdOf(warp);
-            if (!(a < wc || (a == wc && (d2 < warp_d2 || (d2 == warp_d2 && p < balls_.VertexPoint(warp)))))) continue;
+          if (PreferWarp(b, d2, warp, warp_d2)) {
+            warp = b;
+            warp_d2 = d2;
           }
-          warp = b;
-          warp_d2 = d2;
         } else if (balls_.NumVertices(b) == 2) {
           const Vec2 ua = Uv(f, balls_.Vertex(b, 0)), ub = Uv(f, balls_.Vertex(b, 1));
           // Yield when c is deeply inside the piece's disk, or when the
@@ -889,14 +902,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
           if (!straddles && (!DeepInside2(Mid2(ua, ub), HalfLen2(ua, ub), c) || geom::InDiametralCircle(ua, ub, c) <= 0)) {
             continue;
           }
-          if (yield.valid()) {
-            const Cd a = balls_.CdOf(b), y = balls_.CdOf(yield);
-            if (!(a < y || (a == y && (balls_.Radius(b) > balls_.Radius(yield) ||
-                                       (balls_.Radius(b) == balls_.Radius(yield) && b < yield))))) {
-              continue;
-            }
-          }
-          yield = b;
+          if (PreferYield(b, yield)) yield = b;
         }
       }
     }
@@ -988,24 +994,15 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
           const double d2 = geom::Dist2(balls_.Center(b), c);
           if (d2 > theta_r2) continue;
           // Line 6: lowest CD, then nearest to c, then lowest id (determinism).
-          if (warp.valid()) {
-            const Cd a = balls_.CdOf(b), w = balls_.CdOf(warp);
-            if (!(a < w || (a == w && (d2 < warp_d2 || (d2 == warp_d2 && p < balls_.VertexPoint(warp)))))) continue;
+          if (PreferWarp(b, d2, warp, warp_d2)) {
+            warp = b;
+            warp_d2 = d2;
           }
-          warp = b;
-          warp_d2 = d2;
         } else if (balls_.IsAlive(b)) {
           // Strict interior: c on the sphere does not force a yield.
           if (!Inside(b, c)) continue;
           // Lowest CD, then the largest ball, then lowest id.
-          if (yield.valid()) {
-            const Cd a = balls_.CdOf(b), y = balls_.CdOf(yield);
-            if (!(a < y || (a == y && (balls_.Radius(b) > balls_.Radius(yield) ||
-                                       (balls_.Radius(b) == balls_.Radius(yield) && b < yield))))) {
-              continue;
-            }
-          }
-          yield = b;
+          if (PreferYield(b, yield)) yield = b;
         }
       }
     }
