@@ -211,16 +211,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   }
   const double seconds_refine = elapsed() - seconds_validate;
   report("assemble", refined->stats.vertices, 0, 0);
-  std::vector<refine::ConstrainedFace> faces;
-  for (uint32_t f = 0; f < refined->facet_triangles.size(); ++f) {
-    for (const auto& t : refined->facet_triangles[f]) {
-      refine::ConstrainedFace cf;
-      cf.v = t;
-      cf.marker = complex->facets[f].marker;
-      cf.facet = complex->facets[f].input_facet;
-      faces.push_back(cf);
-    }
-  }
+  const std::vector<refine::ConstrainedFace> faces = refine::ConstrainedFacesOf(*refined, *complex);
   mesh::MeshStats stats;
   refined->stats.ExportTo(&stats);
   // Sliver removal by flips (core/svrc/sliver.h; docs/svrc-output.md §7): keeps facet triangles, segment pieces,
@@ -234,11 +225,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   if (!flipped.ok()) return flipped.status();
   flipped->stats.ExportTo(&stats);
   refined->tets = std::move(flipped->tets);
-  refine::CoordinateMap map;
-  // The refiner's exact normalisation, recovered from an input point: the map
-  // is x' = (x − t)·2^−e, identical on every axis scale.
-  map.translation = refined->normalisation_translation;
-  map.exponent = refined->normalisation_exponent;
+  // The refiner's exact normalisation x' = (x − t)·2^−e.
+  const refine::CoordinateMap map = refine::CoordinateMapOf(*refined);
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex, faces, map,
                               keep_box, &stats);

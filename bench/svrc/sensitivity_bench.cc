@@ -145,19 +145,8 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
     return 1;
   }
   const double w2 = WallNow(), c2 = CpuNow();
-  std::vector<refine::ConstrainedFace> faces;
-  for (uint32_t f = 0; f < refined->facet_triangles.size(); ++f) {
-    for (const auto& t : refined->facet_triangles[f]) {
-      refine::ConstrainedFace cf;
-      cf.v = t;
-      cf.marker = complex->facets[f].marker;
-      cf.facet = complex->facets[f].input_facet;
-      faces.push_back(cf);
-    }
-  }
-  refine::CoordinateMap map;
-  map.translation = refined->normalisation_translation;
-  map.exponent = refined->normalisation_exponent;
+  const std::vector<refine::ConstrainedFace> faces = refine::ConstrainedFacesOf(*refined, *complex);
+  const refine::CoordinateMap map = refine::CoordinateMapOf(*refined);
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex,
                               faces, map, keep_box, nullptr);

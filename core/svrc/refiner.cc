@@ -144,6 +144,24 @@ class Refiner {
   // Encroached event): a segment piece or a facet triangle.
   absl::Status DestroyBall(BallId b);
 
+  // Line 3 of Figure 3.4: 𝓑 = the balls linked to `cells` of `mesh`, each
+  // once, in link order (shared by the Ω and facet Destroy).
+  template <typename Cell>
+  void GatherBalls(MeshId mesh, const std::vector<Cell>& cells, std::vector<BallId>* out) {
+    ++ball_stamp_;
+    if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
+    out->clear();
+    for (Cell u : cells) {
+      balls_scratch_.clear();
+      blg_.BallsOf(mesh, u.value(), &balls_scratch_);
+      for (BallId b : balls_scratch_) {
+        if (ball_mark_[b.value()] == ball_stamp_) continue;
+        ball_mark_[b.value()] = ball_stamp_;
+        out->push_back(b);
+      }
+    }
+  }
+
   // Destroy's choices (Figure 3.4 lines 6 and 13): the warp target with the
   // lowest CD, then nearest to c, then the lowest point id; the yield ball
   // with the lowest CD, then the largest, then the lowest id (determinism).
@@ -283,7 +301,7 @@ class Refiner {
   uint32_t stamp_ = 0;
   std::vector<uint32_t> ball_mark_;
   uint32_t ball_stamp_ = 0;
-  std::vector<BallId> balls_scratch_;
+  std::vector<BallId> balls_scratch_, gathered_;
   std::vector<LocationObject> objects_;
 };
 
@@ -861,49 +879,42 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
     stats_.destroy_cells_visited += bfs2_.size();
     BallId warp, yield;
     double warp_d2 = 0;
-    ++ball_stamp_;
-    if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
-    for (VertexId2 u : bfs2_) {
-      balls_scratch_.clear();
-      blg_.BallsOf(mesh, u.value(), &balls_scratch_);
-      for (BallId b : balls_scratch_) {
-        if (ball_mark_[b.value()] == ball_stamp_) continue;
-        ball_mark_[b.value()] = ball_stamp_;
-        if (!(balls_.CdOf(b) < kCdFacet) || !balls_.IsAlive(b)) continue;
-        if (balls_.IsVertexBall(b)) {
-          const PointId p = balls_.VertexPoint(b);
-          if (points_.InMesh(p, mesh)) continue;
-          const Vec2 q = Uv(f, p);
-          const double d2 = (q.x - c.x) * (q.x - c.x) + (q.y - c.y) * (q.y - c.y);
-          // Destroying a triangle's disk, any unresolved lower point strictly
-          // inside it destroys the triangle: warp within r, not θr. A
-          // straddled piece is split towards the crossing until its new
-          // point falls inside the triangle; with θr, a crossing near the
-          // disk's rim was never reached (halving to the last ulp; measured
-          // on knife_edge.poly refined through its creases).
-          if (d2 > (tri.valid() ? r * r * (1 - 1e-9) : theta_r2)) continue;
-          if (PreferWarp(b, d2, warp, warp_d2)) {
-            warp = b;
-            warp_d2 = d2;
-          }
-        } else if (balls_.NumVertices(b) == 2) {
-          const Vec2 ua = Uv(f, balls_.Vertex(b, 0)), ub = Uv(f, balls_.Vertex(b, 1));
-          // Yield when c is deeply inside the piece's disk, or when the
-          // triangle being destroyed straddles the piece: such a triangle is
-          // "in F" only until the piece conforms (guide §5 item 4), and
-          // splitting it while the piece is not an edge of M_F refines the
-          // wrong side of the segment against the neighbouring facet's points
-          // (measured: box_internal_facet ran to the vertex budget).
-          const bool straddles =
-              tri.valid() && m.dt().IsAlive(tri) &&
-              TriangleMeetsSegment(m.dt().Point(m.dt().TriVertex(tri, 0)), m.dt().Point(m.dt().TriVertex(tri, 1)),
-                                   m.dt().Point(m.dt().TriVertex(tri, 2)), ua, ub);
-          if (straddles) ++stats_.straddle_yields;
-          if (!straddles && (!DeepInside2(Mid2(ua, ub), HalfLen2(ua, ub), c) || geom::InDiametralCircle(ua, ub, c) <= 0)) {
-            continue;
-          }
-          if (PreferYield(b, yield)) yield = b;
+    GatherBalls(mesh, bfs2_, &gathered_);
+    for (BallId b : gathered_) {
+      if (!(balls_.CdOf(b) < kCdFacet) || !balls_.IsAlive(b)) continue;
+      if (balls_.IsVertexBall(b)) {
+        const PointId p = balls_.VertexPoint(b);
+        if (points_.InMesh(p, mesh)) continue;
+        const Vec2 q = Uv(f, p);
+        const double d2 = (q.x - c.x) * (q.x - c.x) + (q.y - c.y) * (q.y - c.y);
+        // Destroying a triangle's disk, any unresolved lower point strictly
+        // inside it destroys the triangle: warp within r, not θr. A
+        // straddled piece is split towards the crossing until its new
+        // point falls inside the triangle; with θr, a crossing near the
+        // disk's rim was never reached (halving to the last ulp; measured
+        // on knife_edge.poly refined through its creases).
+        if (d2 > (tri.valid() ? r * r * (1 - 1e-9) : theta_r2)) continue;
+        if (PreferWarp(b, d2, warp, warp_d2)) {
+          warp = b;
+          warp_d2 = d2;
         }
+      } else if (balls_.NumVertices(b) == 2) {
+        const Vec2 ua = Uv(f, balls_.Vertex(b, 0)), ub = Uv(f, balls_.Vertex(b, 1));
+        // Yield when c is deeply inside the piece's disk, or when the
+        // triangle being destroyed straddles the piece: such a triangle is
+        // "in F" only until the piece conforms (guide §5 item 4), and
+        // splitting it while the piece is not an edge of M_F refines the
+        // wrong side of the segment against the neighbouring facet's points
+        // (measured: box_internal_facet ran to the vertex budget).
+        const bool straddles =
+            tri.valid() && m.dt().IsAlive(tri) &&
+            TriangleMeetsSegment(m.dt().Point(m.dt().TriVertex(tri, 0)), m.dt().Point(m.dt().TriVertex(tri, 1)),
+                                 m.dt().Point(m.dt().TriVertex(tri, 2)), ua, ub);
+        if (straddles) ++stats_.straddle_yields;
+        if (!straddles && (!DeepInside2(Mid2(ua, ub), HalfLen2(ua, ub), c) || geom::InDiametralCircle(ua, ub, c) <= 0)) {
+          continue;
+        }
+        if (PreferYield(b, yield)) yield = b;
       }
     }
     if (warp.valid()) {
@@ -979,31 +990,24 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     // guide §3). Line 9: 𝒴 = lower-CD balls with c strictly inside.
     BallId warp, yield;
     double warp_d2 = 0;
-    ++ball_stamp_;
-    if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
-    for (VertexId u : bfs_) {
-      balls_scratch_.clear();
-      blg_.BallsOf(kOmegaMesh, u.value(), &balls_scratch_);
-      for (BallId b : balls_scratch_) {
-        if (ball_mark_[b.value()] == ball_stamp_) continue;
-        ball_mark_[b.value()] = ball_stamp_;
-        if (!(balls_.CdOf(b) < cd_ball)) continue;
-        if (balls_.IsVertexBall(b)) {
-          const PointId p = balls_.VertexPoint(b);
-          if (points_.InMesh(p, kOmegaMesh)) continue;
-          const double d2 = geom::Dist2(balls_.Center(b), c);
-          if (d2 > theta_r2) continue;
-          // Line 6: lowest CD, then nearest to c, then lowest id (determinism).
-          if (PreferWarp(b, d2, warp, warp_d2)) {
-            warp = b;
-            warp_d2 = d2;
-          }
-        } else if (balls_.IsAlive(b)) {
-          // Strict interior: c on the sphere does not force a yield.
-          if (!Inside(b, c)) continue;
-          // Lowest CD, then the largest ball, then lowest id.
-          if (PreferYield(b, yield)) yield = b;
+    GatherBalls(kOmegaMesh, bfs_, &gathered_);
+    for (BallId b : gathered_) {
+      if (!(balls_.CdOf(b) < cd_ball)) continue;
+      if (balls_.IsVertexBall(b)) {
+        const PointId p = balls_.VertexPoint(b);
+        if (points_.InMesh(p, kOmegaMesh)) continue;
+        const double d2 = geom::Dist2(balls_.Center(b), c);
+        if (d2 > theta_r2) continue;
+        // Line 6: lowest CD, then nearest to c, then lowest id (determinism).
+        if (PreferWarp(b, d2, warp, warp_d2)) {
+          warp = b;
+          warp_d2 = d2;
         }
+      } else if (balls_.IsAlive(b)) {
+        // Strict interior: c on the sphere does not force a yield.
+        if (!Inside(b, c)) continue;
+        // Lowest CD, then the largest ball, then lowest id.
+        if (PreferYield(b, yield)) yield = b;
       }
     }
     if (warp.valid()) {
@@ -1846,6 +1850,28 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   s = refiner.VerifyConformity();
   if (!s.ok()) return s;
   return refiner.Output(input);
+}
+
+std::vector<ConstrainedFace> ConstrainedFacesOf(const PointSetRefinement& refined,
+                                                const plc::FeatureComplex& complex) {
+  std::vector<ConstrainedFace> faces;
+  for (uint32_t f = 0; f < refined.facet_triangles.size(); ++f) {
+    for (const auto& t : refined.facet_triangles[f]) {
+      ConstrainedFace cf;
+      cf.v = t;
+      cf.marker = complex.facets[f].marker;
+      cf.facet = complex.facets[f].input_facet;
+      faces.push_back(cf);
+    }
+  }
+  return faces;
+}
+
+CoordinateMap CoordinateMapOf(const PointSetRefinement& refined) {
+  CoordinateMap map;
+  map.translation = refined.normalisation_translation;
+  map.exponent = refined.normalisation_exponent;
+  return map;
 }
 
 absl::StatusOr<PointSetRefinement> RefinePointSet(std::span<const Vec3> points,

@@ -18,6 +18,8 @@
 #include "core/geometry/vec3.h"
 #include "core/mesh/tet_mesh.h"
 #include "core/plc/features.h"
+#include "core/svrc/assemble.h"
+#include "core/svrc/labelling.h"
 
 namespace svrc::refine {
 
@@ -151,5 +153,12 @@ absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const geom:
 // complex points is complex point i (input coordinates, bit-exact).
 absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
                                              const RefineOptions& options);
+
+// The output stage's inputs from a RefinePlc result: its in-facet triangles as
+// constrained faces carrying their facet's marker and input index, and its
+// exact normalisation as the assembly's coordinate map.
+std::vector<ConstrainedFace> ConstrainedFacesOf(const PointSetRefinement& refined,
+                                                const plc::FeatureComplex& complex);
+CoordinateMap CoordinateMapOf(const PointSetRefinement& refined);
 
 }  // namespace svrc::refine
