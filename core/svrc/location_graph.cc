@@ -1,91 +1,132 @@
 // Bipartite Location Graph (thesis §3.2.3, Figure 3.10). See location_graph.h.
 #include "core/svrc/location_graph.h"
 
-#include <map>
-#include <tuple>
+#include <algorithm>
+#include <bit>
+#include <cstring>
 
 namespace svrc::refine {
 
-LocationGraph::List& LocationGraph::CellList(MeshId mesh, uint32_t cell) {
-  if (cell_lists_.size() <= mesh.value()) {
-    cell_lists_.resize(mesh.value() + 1);
+namespace {
+// First block size: most cells and objects hold a handful of links (bounded
+// ply, Lemma 6), so small blocks keep an array within one or two cache lines.
+constexpr uint32_t kMinCap = 4;
+}  // namespace
+
+template <typename Entry>
+void LocationGraph::Arena<Entry>::Append(Span& s, const Entry& e) {
+  if (s.size == s.cap) {
+    const uint32_t cap = s.cap == 0 ? kMinCap : 2 * s.cap;
+    std::vector<uint32_t>& from = free_[std::countr_zero(cap)];
+    uint32_t offset;
+    if (!from.empty()) {
+      offset = from.back();
+      from.pop_back();
+    } else {
+      offset = static_cast<uint32_t>(pool_.size());
+      pool_.resize(pool_.size() + cap);
+    }
+    if (s.size > 0) std::memcpy(pool_.data() + offset, pool_.data() + s.offset, s.size * sizeof(Entry));
+    if (s.cap != 0) free_[std::countr_zero(s.cap)].push_back(s.offset);
+    s.offset = offset;
+    s.cap = cap;
+  }
+  pool_[s.offset + s.size] = e;
+  ++s.size;
+}
+
+template <typename Entry>
+void LocationGraph::Arena<Entry>::Erase(Span& s, uint32_t i) {
+  Entry* d = pool_.data() + s.offset;
+  std::memmove(d + i, d + i + 1, (s.size - i - 1) * sizeof(Entry));
+  --s.size;
+}
+
+LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
+  if (cell_spans_.size() <= mesh.value()) {
+    cell_spans_.resize(mesh.value() + 1);
     unresolved_.resize(mesh.value() + 1);
   }
-  std::vector<List>& lists = cell_lists_[mesh.value()];
-  if (lists.size() <= cell) {
-    lists.resize(cell + 1);
+  std::vector<Span>& spans = cell_spans_[mesh.value()];
+  if (spans.size() <= cell) {
+    spans.resize(cell + 1);
     unresolved_[mesh.value()].resize(cell + 1, 0);
   }
-  return lists[cell];
+  return spans[cell];
 }
 
-const LocationGraph::List* LocationGraph::FindCellList(MeshId mesh, uint32_t cell) const {
-  if (cell_lists_.size() <= mesh.value() || cell_lists_[mesh.value()].size() <= cell) return nullptr;
-  return &cell_lists_[mesh.value()][cell];
+const LocationGraph::Span* LocationGraph::FindCellSpan(MeshId mesh, uint32_t cell) const {
+  if (cell_spans_.size() <= mesh.value() || cell_spans_[mesh.value()].size() <= cell) return nullptr;
+  return &cell_spans_[mesh.value()][cell];
 }
 
-LocationGraph::List& LocationGraph::ObjectList(LocationObject object) {
-  std::vector<List>& lists = object.kind == ObjectKind::kBall ? ball_lists_ : collar_lists_;
-  if (lists.size() <= object.id) lists.resize(object.id + 1);
-  return lists[object.id];
+LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
+  std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
+  if (spans.size() <= object.id) spans.resize(object.id + 1);
+  return spans[object.id];
 }
 
-const LocationGraph::List* LocationGraph::FindObjectList(LocationObject object) const {
-  const std::vector<List>& lists = object.kind == ObjectKind::kBall ? ball_lists_ : collar_lists_;
-  return lists.size() <= object.id ? nullptr : &lists[object.id];
+const LocationGraph::Span* LocationGraph::FindObjectSpan(LocationObject object) const {
+  const std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
+  return spans.size() <= object.id ? nullptr : &spans[object.id];
 }
 
-uint32_t LocationGraph::Find(MeshId mesh, uint32_t cell, LocationObject object) const {
-  // Walk the shorter of the two lists: early in a run one cell can hold
-  // thousands of unresolved points, and an input object can be linked to many
-  // cells; the other list is then short (bounded ply, Lemma 6).
-  const List* cl = FindCellList(mesh, cell);
-  const List* ol = FindObjectList(object);
-  if (cl == nullptr || ol == nullptr) return kNil;
-  if (cl->size <= ol->size) {
-    for (uint32_t l = cl->head; l != kNil; l = links_[l].next_cell) {
-      if (links_[l].object == object) return l;
-    }
-  } else {
-    for (uint32_t l = ol->head; l != kNil; l = links_[l].next_obj) {
-      if (links_[l].cell == cell && links_[l].mesh == mesh) return l;
-    }
+uint32_t LocationGraph::CellPos(const Span& cs, LocationObject object) const {
+  const CellEntry* e = cell_arena_.Data(cs);
+  for (uint32_t i = 0; i < cs.size; ++i) {
+    if (e[i].Is(object)) return i;
   }
   return kNil;
+}
+
+uint32_t LocationGraph::ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const {
+  const ObjectEntry* e = object_arena_.Data(os);
+  for (uint32_t i = 0; i < os.size; ++i) {
+    if (e[i].cell == cell && e[i].mesh == mesh.value()) return i;
+  }
+  return kNil;
+}
+
+bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) const {
+  // Scan the shorter of the two arrays: early in a run one cell can hold
+  // thousands of unresolved points, and an input object can be linked to many
+  // cells; the other array is then short (bounded ply, Lemma 6).
+  const Span* cs = FindCellSpan(mesh, cell);
+  const Span* os = FindObjectSpan(object);
+  if (cs == nullptr || os == nullptr || cs->size == 0 || os->size == 0) return false;
+  if (cs->size <= os->size) return CellPos(*cs, object) != kNil;
+  return ObjectPos(*os, mesh, cell) != kNil;
+}
+
+uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t cell) {
+  uint32_t l;
+  if (free_record_ != kNil) {
+    l = free_record_;
+    free_record_ = records_[l].mesh;
+  } else {
+    l = static_cast<uint32_t>(records_.size());
+    records_.emplace_back();
+  }
+  records_[l] = LinkRecord{object, mesh.value(), cell};
+  return l;
+}
+
+void LocationGraph::FreeRecord(uint32_t l) {
+  records_[l].cell = kNil;
+  records_[l].mesh = free_record_;
+  free_record_ = l;
 }
 
 AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject object,
                                      const LinkFacts& facts, BallStore* balls) {
   AddLinkResult result;
-  if (Find(mesh, cell, object) != kNil) {
+  if (IsLinked(mesh, cell, object)) {
     ++stats_.duplicates_refused;
     return result;
   }
-  uint32_t l;
-  if (free_head_ != kNil) {
-    l = free_head_;
-    free_head_ = links_[l].next_obj;
-  } else {
-    l = static_cast<uint32_t>(links_.size());
-    links_.emplace_back();
-  }
-  Link& link = links_[l];
-  link = Link{};
-  link.object = object;
-  link.mesh = mesh;
-  link.cell = cell;
-  link.unresolved = facts.unresolved;
-
-  List& cl = CellList(mesh, cell);
-  link.prev_cell = cl.tail;
-  if (cl.tail != kNil) links_[cl.tail].next_cell = l; else cl.head = l;
-  cl.tail = l;
-  ++cl.size;
-  List& ol = ObjectList(object);
-  link.prev_obj = ol.tail;
-  if (ol.tail != kNil) links_[ol.tail].next_obj = l; else ol.head = l;
-  ol.tail = l;
-  ++ol.size;
+  const uint32_t l = NewRecord(object, mesh, cell);
+  cell_arena_.Append(CellSpan(mesh, cell), CellEntry{object.id, object.kind, facts.unresolved});
+  object_arena_.Append(ObjectSpan(object), ObjectEntry{mesh.value(), cell, l});
   ++num_links_;
   ++stats_.links_added;
   result.link = LinkId(l);
@@ -107,82 +148,103 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   return result;
 }
 
-void LocationGraph::RemoveLink(LinkId id) {
-  const uint32_t l = id.value();
-  Link& link = links_[l];
-  if (link.cell == kNil) return;
-  List& cl = cell_lists_[link.mesh.value()][link.cell];
-  if (link.prev_cell != kNil) links_[link.prev_cell].next_cell = link.next_cell; else cl.head = link.next_cell;
-  if (link.next_cell != kNil) links_[link.next_cell].prev_cell = link.prev_cell; else cl.tail = link.prev_cell;
-  List& ol = ObjectList(link.object);
-  if (link.prev_obj != kNil) links_[link.prev_obj].next_obj = link.next_obj; else ol.head = link.next_obj;
-  if (link.next_obj != kNil) links_[link.next_obj].prev_obj = link.prev_obj; else ol.tail = link.prev_obj;
-  --cl.size;
-  --ol.size;
-  if (link.unresolved) --unresolved_[link.mesh.value()][link.cell];
-  link.cell = kNil;
-  link.prev_cell = link.next_cell = link.prev_obj = kNil;
-  link.next_obj = free_head_;
-  free_head_ = l;
+void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshId mesh, uint32_t cell) {
+  if (cell_arena_.Data(cs)[ci].unresolved) --unresolved_[mesh.value()][cell];
+  FreeRecord(object_arena_.Data(os)[oi].link);
+  cell_arena_.Erase(cs, ci);
+  object_arena_.Erase(os, oi);
   --num_links_;
   ++stats_.links_removed;
 }
 
+void LocationGraph::RemoveLink(LinkId id) {
+  if (!id.valid() || id.value() >= records_.size()) return;
+  const LinkRecord rec = records_[id.value()];
+  if (rec.cell == kNil) return;
+  RemoveLink(MeshId(rec.mesh), rec.cell, rec.object);
+}
+
 bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object) {
-  const uint32_t l = Find(mesh, cell, object);
-  if (l == kNil) return false;
-  RemoveLink(LinkId(l));
+  const Span* cs = FindCellSpan(mesh, cell);
+  const Span* os = FindObjectSpan(object);
+  if (cs == nullptr || os == nullptr) return false;
+  const uint32_t oi = ObjectPos(*os, mesh, cell);
+  if (oi == kNil) return false;
+  const uint32_t ci = CellPos(*cs, object);
+  RemoveAt(cell_spans_[mesh.value()][cell], ci, ObjectSpan(object), oi, mesh, cell);
   return true;
 }
 
 void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<LocationObject>* removed) {
-  const List* list = FindCellList(mesh, cell);
-  if (list == nullptr) return;
-  while (list->head != kNil) {
-    const uint32_t l = list->head;
-    if (removed != nullptr) removed->push_back(links_[l].object);
-    RemoveLink(LinkId(l));
+  if (FindCellSpan(mesh, cell) == nullptr) return;
+  Span& cs = cell_spans_[mesh.value()][cell];
+  // Front to back, as RemoveLink of each in turn would; the cell's array is
+  // emptied at the end instead of shifting it once per link.
+  const CellEntry* e = cell_arena_.Data(cs);
+  uint32_t unresolved = 0;
+  for (uint32_t i = 0; i < cs.size; ++i) {
+    const LocationObject object = e[i].object();
+    if (removed != nullptr) removed->push_back(object);
+    if (e[i].unresolved) ++unresolved;
+    Span& os = ObjectSpan(object);
+    const uint32_t oi = ObjectPos(os, mesh, cell);
+    FreeRecord(object_arena_.Data(os)[oi].link);
+    object_arena_.Erase(os, oi);
   }
+  unresolved_[mesh.value()][cell] -= unresolved;
+  num_links_ -= cs.size;
+  stats_.links_removed += cs.size;
+  cs.size = 0;
 }
 
 void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::vector<uint32_t>* cells) {
-  const List* list = FindObjectList(object);
-  if (list == nullptr) return;
-  uint32_t l = list->head;
-  while (l != kNil) {
-    const uint32_t next = links_[l].next_obj;
-    if (!mesh.valid() || links_[l].mesh == mesh) {
-      if (cells != nullptr) cells->push_back(links_[l].cell);
-      RemoveLink(LinkId(l));
+  if (FindObjectSpan(object) == nullptr) return;
+  Span& os = ObjectSpan(object);
+  // One stable compaction pass over the object's array: the kept entries keep
+  // their order, the removed ones are reported in link order.
+  ObjectEntry* e = object_arena_.Data(os);
+  uint32_t kept = 0;
+  for (uint32_t i = 0; i < os.size; ++i) {
+    const ObjectEntry oe = e[i];
+    if (mesh.valid() && oe.mesh != mesh.value()) {
+      e[kept++] = oe;
+      continue;
     }
-    l = next;
+    if (cells != nullptr) cells->push_back(oe.cell);
+    Span& cs = cell_spans_[oe.mesh][oe.cell];
+    const uint32_t ci = CellPos(cs, object);
+    if (cell_arena_.Data(cs)[ci].unresolved) --unresolved_[oe.mesh][oe.cell];
+    cell_arena_.Erase(cs, ci);
+    FreeRecord(oe.link);
+    --num_links_;
+    ++stats_.links_removed;
   }
+  os.size = kept;
 }
 
 void LocationGraph::BallsOf(MeshId mesh, uint32_t cell, std::vector<BallId>* out) const {
-  const List* list = FindCellList(mesh, cell);
-  if (list == nullptr) return;
-  for (uint32_t l = list->head; l != kNil; l = links_[l].next_cell) {
-    if (links_[l].object.kind == ObjectKind::kBall) out->push_back(BallId(links_[l].object.id));
+  const Span* cs = FindCellSpan(mesh, cell);
+  if (cs == nullptr) return;
+  const CellEntry* e = cell_arena_.Data(*cs);
+  for (uint32_t i = 0; i < cs->size; ++i) {
+    if (e[i].kind == ObjectKind::kBall) out->push_back(BallId(e[i].object_id));
   }
 }
 
 void LocationGraph::ObjectsOf(MeshId mesh, uint32_t cell, std::vector<LocationObject>* out) const {
-  const List* list = FindCellList(mesh, cell);
-  if (list == nullptr) return;
-  for (uint32_t l = list->head; l != kNil; l = links_[l].next_cell) out->push_back(links_[l].object);
+  const Span* cs = FindCellSpan(mesh, cell);
+  if (cs == nullptr) return;
+  const CellEntry* e = cell_arena_.Data(*cs);
+  for (uint32_t i = 0; i < cs->size; ++i) out->push_back(e[i].object());
 }
 
 void LocationGraph::CellsOf(LocationObject object, MeshId mesh, std::vector<uint32_t>* out) const {
-  const List* list = FindObjectList(object);
-  if (list == nullptr) return;
-  for (uint32_t l = list->head; l != kNil; l = links_[l].next_obj) {
-    if (links_[l].mesh == mesh) out->push_back(links_[l].cell);
+  const Span* os = FindObjectSpan(object);
+  if (os == nullptr) return;
+  const ObjectEntry* e = object_arena_.Data(*os);
+  for (uint32_t i = 0; i < os->size; ++i) {
+    if (e[i].mesh == mesh.value()) out->push_back(e[i].cell);
   }
-}
-
-bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) const {
-  return Find(mesh, cell, object) != kNil;
 }
 
 uint32_t LocationGraph::NumUnresolved(MeshId mesh, uint32_t cell) const {
@@ -191,48 +253,69 @@ uint32_t LocationGraph::NumUnresolved(MeshId mesh, uint32_t cell) const {
 }
 
 bool LocationGraph::Validate() const {
-  // Walk every cell list and every object list; each live link must be seen
-  // exactly once from each side with consistent back pointers.
-  std::vector<uint8_t> seen_cell(links_.size(), 0), seen_obj(links_.size(), 0);
-  std::map<std::tuple<uint32_t, uint32_t, uint8_t, uint32_t>, int> pairs;
-  uint32_t count = 0;
-  for (uint32_t m = 0; m < cell_lists_.size(); ++m) {
-    for (uint32_t c = 0; c < cell_lists_[m].size(); ++c) {
-      const List& list = cell_lists_[m][c];
-      uint32_t prev = kNil, unresolved = 0;
-      for (uint32_t l = list.head; l != kNil; l = links_[l].next_cell) {
-        const Link& link = links_[l];
-        if (link.cell != c || link.mesh.value() != m || link.prev_cell != prev) return false;
+  // Cell side: each entry must have its partner (mesh, cell) in the object's
+  // array, whose record names this (object, mesh, cell); every record must be
+  // reached exactly once. A duplicate object in a cell reaches the same
+  // record twice and fails.
+  std::vector<uint8_t> seen_cell(records_.size(), 0), seen_obj(records_.size(), 0);
+  uint64_t count = 0;
+  for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
+    for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
+      const Span& cs = cell_spans_[m][c];
+      if (cs.size > cs.cap) return false;
+      const CellEntry* e = cell_arena_.Data(cs);
+      uint32_t unresolved = 0;
+      for (uint32_t i = 0; i < cs.size; ++i) {
+        const LocationObject o = e[i].object();
+        const Span* os = FindObjectSpan(o);
+        if (os == nullptr) return false;
+        const uint32_t oi = ObjectPos(*os, MeshId(m), c);
+        if (oi == kNil) return false;
+        const uint32_t l = object_arena_.Data(*os)[oi].link;
+        if (l >= records_.size()) return false;
+        const LinkRecord& rec = records_[l];
+        if (rec.cell != c || rec.mesh != m || !(rec.object == o)) return false;
         if (seen_cell[l]++) return false;
-        if (link.unresolved) ++unresolved;
-        if (++pairs[{m, c, static_cast<uint8_t>(link.object.kind), link.object.id}] > 1) return false;
-        prev = l;
+        if (e[i].unresolved) ++unresolved;
         ++count;
       }
-      if (list.tail != prev || unresolved_[m][c] != unresolved) return false;
+      if (unresolved_[m][c] != unresolved) return false;
     }
   }
+  // Object side: each entry's record names this object and its (mesh, cell),
+  // and the cell's array holds the object exactly once.
   for (int kind = 0; kind < 2; ++kind) {
-    const std::vector<List>& lists = kind == 0 ? ball_lists_ : collar_lists_;
-    for (uint32_t o = 0; o < lists.size(); ++o) {
-      uint32_t prev = kNil;
-      for (uint32_t l = lists[o].head; l != kNil; l = links_[l].next_obj) {
-        const Link& link = links_[l];
-        if (link.cell == kNil || static_cast<int>(link.object.kind) != kind || link.object.id != o ||
-            link.prev_obj != prev) {
-          return false;
-        }
+    const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
+    for (uint32_t id = 0; id < spans.size(); ++id) {
+      const Span& os = spans[id];
+      if (os.size > os.cap) return false;
+      const LocationObject o{static_cast<ObjectKind>(kind), id};
+      const ObjectEntry* e = object_arena_.Data(os);
+      for (uint32_t i = 0; i < os.size; ++i) {
+        const uint32_t l = e[i].link;
+        if (l >= records_.size()) return false;
+        const LinkRecord& rec = records_[l];
+        if (rec.cell != e[i].cell || rec.mesh != e[i].mesh || !(rec.object == o)) return false;
         if (seen_obj[l]++) return false;
-        prev = l;
+        const Span* cs = FindCellSpan(MeshId(e[i].mesh), e[i].cell);
+        if (cs == nullptr) return false;
+        const CellEntry* ce = cell_arena_.Data(*cs);
+        uint32_t found = 0;
+        for (uint32_t j = 0; j < cs->size; ++j) found += ce[j].Is(o) ? 1 : 0;
+        if (found != 1) return false;
       }
-      if (lists[o].tail != prev) return false;
     }
   }
-  for (uint32_t l = 0; l < links_.size(); ++l) {
-    const bool live = links_[l].cell != kNil;
+  // Live records are exactly the ones both sides reached; free ones neither.
+  uint32_t free_count = 0;
+  for (uint32_t l = free_record_; l != kNil; l = records_[l].mesh) {
+    if (l >= records_.size() || records_[l].cell != kNil || ++free_count > records_.size()) return false;
+  }
+  for (uint32_t l = 0; l < records_.size(); ++l) {
+    const bool live = records_[l].cell != kNil;
     if (live != (seen_cell[l] == 1) || live != (seen_obj[l] == 1)) return false;
   }
-  return count == num_links_;
+  return count == num_links_ && free_count + num_links_ == records_.size();
 }
 
 }  // namespace svrc::refine

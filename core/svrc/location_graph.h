@@ -4,10 +4,15 @@
 // proportional to the answer, and traps encroachment and unresolved objects as
 // links are added (AddLink) so the refiner can enqueue work events.
 //
-// Representation (guide §2 "BLG"): a pool of link records {object, mesh, cell,
-// prev/next in the object's list, prev/next in the cell's list} with a free
-// list; both lists are intrusive, doubly linked and append at the tail, so
-// iteration order is the order of AddLink calls: deterministic.
+// Representation (guide §2 "BLG"; issue #5): contiguous arrays, not linked
+// lists. Per (mesh, cell) one array of {object, unresolved} entries, per object
+// one array of {mesh, cell, link} entries; each array is a block of a shared
+// arena (power-of-two capacities, recycled through per-size free lists). Adds
+// append at the end and removals shift the tail down by one, so iteration
+// order is the order of AddLink calls (deterministic; the refiner's output
+// depends on it). A small pool of {object, mesh, cell} records gives each
+// link a LinkId for RemoveLink(LinkId). A query walks one short array (bounded
+// ply, Lemma 6) instead of chasing one pointer per link.
 #pragma once
 
 #include <cstdint>
@@ -77,9 +82,11 @@ class LocationGraph {
 
   uint32_t NumLinks() const { return num_links_; }
 
-  // Both directions agree: every link is in exactly its object's list and its
-  // cell's list, prev/next consistent, unresolved counters match, no duplicate
-  // (object, mesh, cell). Linear time. For tests and debug builds.
+  // Both directions agree: every link is in exactly its object's array and
+  // its cell's array, each entry of either side has its partner on the other
+  // side and in the link records, unresolved counters match, no duplicate
+  // (object, mesh, cell). Time linear in links × array length. For tests and
+  // debug builds.
   bool Validate() const;
 
   struct Stats {
@@ -91,32 +98,77 @@ class LocationGraph {
 
  private:
   static constexpr uint32_t kNil = 0xFFFFFFFFu;
-  struct Link {
-    LocationObject object;
-    MeshId mesh;
-    uint32_t cell = kNil;  // kNil: free slot
-    uint32_t prev_obj = kNil, next_obj = kNil;
-    uint32_t prev_cell = kNil, next_cell = kNil;
-    bool unresolved = false;
-  };
-  struct List {
-    uint32_t head = kNil, tail = kNil;
+
+  // One block of an Arena: entries [offset, offset + size), room for `cap`.
+  struct Span {
+    uint32_t offset = 0;
     uint32_t size = 0;
+    uint32_t cap = 0;  // 0: no block yet; otherwise a power of two
+  };
+  // Blocks of small arrays in one vector. A full block moves to a block of
+  // twice its capacity (taken from that size's free list, else appended); the
+  // old block goes to its free list. Blocks of emptied arrays are kept: a cell
+  // emptied by UpdateLocation is usually refilled at once.
+  template <typename Entry>
+  class Arena {
+   public:
+    Entry* Data(const Span& s) { return pool_.data() + s.offset; }
+    const Entry* Data(const Span& s) const { return pool_.data() + s.offset; }
+    // Appends `e` to the array of `s` (entries keep their order).
+    void Append(Span& s, const Entry& e);
+    // Removes entry `i` of `s`, shifting the later entries down (order kept).
+    void Erase(Span& s, uint32_t i);
+
+   private:
+    std::vector<Entry> pool_;
+    std::vector<uint32_t> free_[32];  // [log2 cap] offsets of free blocks
   };
 
-  List& CellList(MeshId mesh, uint32_t cell);
-  const List* FindCellList(MeshId mesh, uint32_t cell) const;
-  List& ObjectList(LocationObject object);
-  const List* FindObjectList(LocationObject object) const;
-  uint32_t Find(MeshId mesh, uint32_t cell, LocationObject object) const;
+  // The cell side: which object, and whether the link counts as unresolved.
+  struct CellEntry {
+    uint32_t object_id = 0;
+    ObjectKind kind = ObjectKind::kBall;
+    bool unresolved = false;
+    LocationObject object() const { return {kind, object_id}; }
+    bool Is(LocationObject o) const { return object_id == o.id && kind == o.kind; }
+  };
+  // The object side: which cell of which mesh, and the link's record.
+  struct ObjectEntry {
+    uint32_t mesh = 0;
+    uint32_t cell = 0;
+    uint32_t link = 0;
+  };
+  // LinkId → its ends (RemoveLink(LinkId), Validate). cell == kNil: free, and
+  // `mesh` holds the next free record.
+  struct LinkRecord {
+    LocationObject object;
+    uint32_t mesh = kNil;
+    uint32_t cell = kNil;
+  };
 
-  std::vector<Link> links_;
-  uint32_t free_head_ = kNil;
+  Span& CellSpan(MeshId mesh, uint32_t cell);
+  const Span* FindCellSpan(MeshId mesh, uint32_t cell) const;
+  Span& ObjectSpan(LocationObject object);
+  const Span* FindObjectSpan(LocationObject object) const;
+  // Position of `object` in the cell's array / of (mesh, cell) in the
+  // object's array; kNil when absent.
+  uint32_t CellPos(const Span& cs, LocationObject object) const;
+  uint32_t ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const;
+  uint32_t NewRecord(LocationObject object, MeshId mesh, uint32_t cell);
+  void FreeRecord(uint32_t l);
+  // Removes entry `oi` of the object's array and entry `ci` of the cell's
+  // array, which must be the same link.
+  void RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshId mesh, uint32_t cell);
+
+  Arena<CellEntry> cell_arena_;
+  Arena<ObjectEntry> object_arena_;
+  std::vector<LinkRecord> records_;
+  uint32_t free_record_ = kNil;
   uint32_t num_links_ = 0;
-  std::vector<std::vector<List>> cell_lists_;  // [mesh][cell]
+  std::vector<std::vector<Span>> cell_spans_;      // [mesh][cell]
   std::vector<std::vector<uint32_t>> unresolved_;  // [mesh][cell]
-  std::vector<List> ball_lists_;
-  std::vector<List> collar_lists_;
+  std::vector<Span> ball_spans_;
+  std::vector<Span> collar_spans_;
   Stats stats_;
 };
 
