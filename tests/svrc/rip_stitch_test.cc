@@ -1,0 +1,414 @@
+// RipStitchCollar (Figure 3.12, stage (f)): Delaunay meshes of collar scenes
+// (one ball; a chain of balls on a crease segment; a vertex ball with two
+// segment chains at 30°) are ripped and stitched; the output is checked
+// independently: positive tets, every face in two tets with opposite sides or
+// on the cube, total volume = the cube's, crease vertices and edges present,
+// removed points in no tet, dihedrals within the doc's bounds. Negative: a
+// sparse sample and a hemisphere sample are refused with locations on S, an
+// unlisted crossing pair is refused.
+#include "core/svrc/rip_stitch.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "core/delaunay/delaunay3.h"
+#include "core/geometry/predicates.h"
+#include "gtest/gtest.h"
+
+namespace svrc::refine {
+namespace {
+
+using delaunay::Delaunay3;
+using delaunay::VertexId;
+using Edge = std::pair<uint32_t, uint32_t>;
+
+// Near-uniform directions (golden-angle spiral), rotated by `seed` so scenes
+// differ; deterministic.
+std::vector<Vec3> SpiralDirections(int n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * std::numbers::pi);
+  const double a = u(rng), b = u(rng);
+  const double ca = std::cos(a), sa = std::sin(a), cb = std::cos(b), sb = std::sin(b);
+  std::vector<Vec3> out;
+  const double golden = std::numbers::pi * (3 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z), t = golden * i;
+    Vec3 p(r * std::cos(t), r * std::sin(t), z);
+    p = Vec3(ca * p.x - sa * p.y, sa * p.x + ca * p.y, p.z);   // about z
+    p = Vec3(p.x, cb * p.y - sb * p.z, sb * p.y + cb * p.z);   // about x
+    out.push_back(p);
+  }
+  return out;
+}
+
+double DistToCircle(const Vec3& p, const Circle3& c) {
+  const Vec3 d = p - c.center;
+  const double ax = geom::Dot(d, c.normal);
+  const double rad = geom::Norm(d - ax * c.normal);
+  return std::hypot(ax, rad - c.radius);
+}
+
+// Signed distance from p to the union's boundary, taken as min_j(|p c_j| − ρ_j)
+// (negative inside some ball).
+double UnionGap(const Vec3& p, const std::vector<CollarBall>& balls) {
+  double g = std::numeric_limits<double>::infinity();
+  for (const CollarBall& b : balls) g = std::min(g, geom::Dist(p, b.center) - b.radius);
+  return g;
+}
+
+// A refined mesh around a collar system as the refiner would leave it: the
+// crease vertices (ball centres), samples of every circle and partial sphere
+// at spacing ≈ h·ρ (a third of the sphere samples radially jittered by
+// 1–3 %), two shells of outside points, a few points deep inside each ball
+// (to be removed), random points away from the balls, the cube's corners.
+struct Scene {
+  Delaunay3 dt;
+  std::vector<CollarBall> balls;
+  std::vector<StitchBall> stitch_balls;
+  std::vector<Edge> crease_edges;
+  std::vector<uint32_t> deep_inside;  // vertices that must be removed
+  double lo = -4, hi = 4;
+  uint32_t next_id = 0;
+
+  VertexId Add(const Vec3& p) { return dt.Insert(p, next_id++).vertex; }
+};
+
+void BuildScene(Scene* s, double h, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const std::vector<CollarBall>& balls = s->balls;
+  for (const CollarBall& b : balls) s->stitch_balls.push_back({b, s->Add(b.center)});
+  std::vector<Circle3> circles;
+  for (auto [i, j] : s->crease_edges) {
+    Circle3 c;
+    if (!SphereSphereCircle(balls[i], balls[j], &c)) continue;
+    circles.push_back(c);
+    const double spacing = h * std::min(balls[i].radius, balls[j].radius);
+    const int n = std::max(8, static_cast<int>(std::ceil(2 * std::numbers::pi * c.radius / spacing)));
+    const double phase = u01(rng);
+    for (int k = 0; k < n; ++k) s->Add(CirclePoint(c, 2 * std::numbers::pi * (k + phase) / n));
+  }
+  for (uint32_t i = 0; i < balls.size(); ++i) {
+    const CollarBall& b = balls[i];
+    const int n = static_cast<int>(std::ceil(4 * std::numbers::pi / (h * h)));
+    int k = 0;
+    for (const Vec3& d : SpiralDirections(n, seed * 31 + i)) {
+      Vec3 p = b.center + b.radius * d;
+      bool keep = true;
+      for (uint32_t j = 0; j < balls.size(); ++j) {
+        if (j != i && geom::Dist(p, balls[j].center) - balls[j].radius < 0.5 * h * b.radius) keep = false;
+      }
+      for (const Circle3& c : circles) {
+        if (DistToCircle(p, c) < 0.6 * h * b.radius) keep = false;
+      }
+      if (!keep) continue;
+      if (k++ % 3 == 0) {
+        const double j = (0.01 + 0.02 * u01(rng)) * (u01(rng) < 0.5 ? -1 : 1);
+        p = b.center + b.radius * (1 + j) * d;
+      }
+      s->Add(p);
+    }
+    // Outside shells.
+    for (double f : {1.45, 2.2}) {
+      for (const Vec3& d : SpiralDirections(n / (f < 2 ? 3 : 8), seed * 57 + i)) {
+        const Vec3 p = b.center + f * b.radius * d;
+        if (UnionGap(p, balls) > 0.3 * b.radius && p.x > s->lo && p.x < s->hi && p.y > s->lo &&
+            p.y < s->hi && p.z > s->lo && p.z < s->hi) {
+          s->Add(p);
+        }
+      }
+    }
+    // Deep inside (their cells are inside the collars: removed).
+    for (const Vec3& d : SpiralDirections(10, seed * 91 + i)) {
+      const Vec3 p = b.center + 0.5 * b.radius * d;
+      s->deep_inside.push_back(s->Add(p).value());
+    }
+  }
+  double rmax = 0;
+  for (const CollarBall& b : balls) rmax = std::max(rmax, b.radius);
+  std::uniform_real_distribution<double> uc(s->lo, s->hi);
+  for (int k = 0; k < 150; ++k) {
+    const Vec3 p(uc(rng), uc(rng), uc(rng));
+    if (UnionGap(p, balls) > 0.8 * rmax) s->Add(p);
+  }
+  for (int c = 0; c < 8; ++c) {
+    s->Add(Vec3(c & 1 ? s->hi : s->lo, c & 2 ? s->hi : s->lo, c & 4 ? s->hi : s->lo));
+  }
+}
+
+StitchInput InputOf(const Scene& s) {
+  StitchInput in;
+  in.dt = &s.dt;
+  in.balls = s.stitch_balls;
+  in.crease_edges = s.crease_edges;
+  return in;
+}
+
+double Volume6(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return geom::Dot(geom::Cross(b - a, c - a), d - a);
+}
+
+// Independent checks of the output mesh (not the stitcher's own verification).
+void CheckMesh(const Scene& s, const StitchResult& r, const char* name) {
+  const Delaunay3& dt = s.dt;
+  auto P = [&dt](uint32_t v) { return dt.Point(VertexId(v)); };
+  ASSERT_EQ(r.tets.size(), size_t{r.outside_tets} + r.stars + r.books) << name;
+  // Positive orientation, volume (compensated sum).
+  double vol = 0, comp = 0;
+  for (const auto& t : r.tets) {
+    ASSERT_GT(geom::Orient3d(P(t[0]), P(t[1]), P(t[2]), P(t[3])), 0) << name;
+    const double y = Volume6(P(t[0]), P(t[1]), P(t[2]), P(t[3])) / 6 - comp;
+    const double z = vol + y;
+    comp = (z - vol) - y;
+    vol = z;
+  }
+  const double cube = std::pow(s.hi - s.lo, 3);
+  EXPECT_NEAR(vol, cube, 1e-12 * cube) << name;
+  // Every face in exactly two tets on opposite sides, or in one tet and on the
+  // cube's boundary (all three vertices on one cube face).
+  std::vector<std::pair<std::array<uint32_t, 3>, int>> faces;
+  for (const auto& t : r.tets) {
+    for (int k = 0; k < 4; ++k) {
+      std::array<uint32_t, 3> f;
+      for (int i = 0, m = 0; i < 4; ++i) {
+        if (i != k) f[m++] = t[i];
+      }
+      const int side = geom::Orient3d(P(f[0]), P(f[1]), P(f[2]), P(t[k]));  // in tet order
+      std::array<uint32_t, 3> sorted = f;
+      std::sort(sorted.begin(), sorted.end());
+      const int sorted_side = geom::Orient3d(P(sorted[0]), P(sorted[1]), P(sorted[2]), P(t[k]));
+      ASSERT_NE(side, 0) << name;
+      faces.push_back({sorted, sorted_side});
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  size_t boundary = 0;
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i;
+    while (j < faces.size() && faces[j].first == faces[i].first) ++j;
+    const auto& f = faces[i].first;
+    if (j - i == 2) {
+      EXPECT_NE(faces[i].second, faces[i + 1].second) << name << " face " << f[0] << "," << f[1] << "," << f[2];
+    } else {
+      ASSERT_EQ(j - i, 1u) << name << " face " << f[0] << "," << f[1] << "," << f[2];
+      bool on_cube = false;
+      for (int axis = 0; axis < 3; ++axis) {
+        for (double c : {s.lo, s.hi}) {
+          if (P(f[0])[axis] == c && P(f[1])[axis] == c && P(f[2])[axis] == c) on_cube = true;
+        }
+      }
+      EXPECT_TRUE(on_cube) << name << " open face " << f[0] << "," << f[1] << "," << f[2];
+      ++boundary;
+    }
+    i = j;
+  }
+  EXPECT_GE(boundary, 12u) << name;
+  // Vertices: crease vertices used; removed vertices (including every
+  // deep-inside point) in no tet; every other vertex in some tet.
+  std::vector<uint8_t> used(dt.NumVertices(), 0);
+  std::set<Edge> edges;
+  for (const auto& t : r.tets) {
+    for (int i = 0; i < 4; ++i) {
+      used[t[i]] = 1;
+      for (int j = i + 1; j < 4; ++j) edges.insert({std::min(t[i], t[j]), std::max(t[i], t[j])});
+    }
+  }
+  std::vector<uint8_t> removed(dt.NumVertices(), 0);
+  for (uint32_t v : r.removed_vertices) {
+    removed[v] = 1;
+    EXPECT_FALSE(used[v]) << name << " removed vertex " << v << " is in a tet";
+  }
+  for (uint32_t v : s.deep_inside) EXPECT_TRUE(removed[v]) << name << " deep-inside vertex " << v << " kept";
+  for (uint32_t v = 0; v < dt.NumVertices(); ++v) {
+    if (!removed[v]) {
+      EXPECT_TRUE(used[v]) << name << " vertex " << v << " lost";
+    }
+  }
+  for (const StitchBall& b : s.stitch_balls) EXPECT_TRUE(used[b.centre.value()]) << name;
+  for (auto [i, j] : s.crease_edges) {
+    const uint32_t v = s.stitch_balls[i].centre.value(), w = s.stitch_balls[j].centre.value();
+    EXPECT_TRUE(edges.count({std::min(v, w), std::max(v, w)})) << name << " crease edge " << i << "-" << j;
+  }
+  // Dihedral maxima within the doc's bounds (Theorems 1–2) at the measured σ, ε, γ/α.
+  EXPECT_GT(r.stars, 0u);
+  EXPECT_TRUE(r.star_bound_valid) << name;
+  EXPECT_LE(r.max_star_base_deg, r.star_bound_base_deg) << name;
+  EXPECT_LE(r.max_star_radial_deg, r.star_bound_radial_deg) << name;
+  if (r.books > 0) {
+    EXPECT_TRUE(r.book_bound_valid) << name;
+    EXPECT_LE(r.max_book_ab_deg, r.book_bound_ab_deg) << name;
+    EXPECT_LE(r.max_book_side_deg, r.book_bound_side_deg) << name;
+    EXPECT_LE(r.max_book_axis_deg, r.book_bound_axis_deg) << name;
+  }
+  std::printf(
+      "%s: %zu tets (%u outside, %u inside removed, %u stars, %u books), %zu vertices removed\n"
+      "  stars: max base %.2f° (bound %.2f°), max radial %.2f° (bound %.2f°); σmax %.2f° εmax %.3f γmax %.2f°\n",
+      name, r.tets.size(), r.outside_tets, r.inside_tets, r.stars, r.books, r.removed_vertices.size(),
+      r.max_star_base_deg, r.star_bound_base_deg, r.max_star_radial_deg, r.star_bound_radial_deg,
+      r.star_sigma_max_deg, r.star_eps_max, r.star_gamma_max_deg);
+  if (r.books > 0) {
+    std::printf(
+        "  books: max at ab %.2f° (bound %.2f°), max side %.2f° (bound %.2f°), max at axis %.2f° (bound %.2f°); "
+        "σmax %.2f° εmax %.3f αmax %.2f°\n",
+        r.max_book_ab_deg, r.book_bound_ab_deg, r.max_book_side_deg, r.book_bound_side_deg, r.max_book_axis_deg,
+        r.book_bound_axis_deg, r.book_sigma_max_deg, r.book_eps_max, r.book_alpha_max_deg);
+  }
+}
+
+std::string Describe(const std::vector<StitchFailure>& f) {
+  std::string s;
+  for (size_t i = 0; i < f.size() && i < 5; ++i) {
+    s += std::string(StitchFailureKindName(f[i].kind)) + " " + f[i].detail + "\n";
+  }
+  return s;
+}
+
+TEST(RipStitchTest, SingleBall) {
+  for (uint64_t seed : {1, 2, 3}) {
+    Scene s;
+    s.balls = {{Vec3(0.1, -0.2, 0.05), 1.0}};
+    BuildScene(&s, 0.2, seed);
+    std::vector<StitchFailure> fails;
+    const absl::StatusOr<StitchResult> r = RipStitchCollar(InputOf(s), &fails);
+    ASSERT_TRUE(r.ok()) << r.status() << "\n" << Describe(fails);
+    EXPECT_TRUE(fails.empty());
+    EXPECT_EQ(r->books, 0u);
+    CheckMesh(s, *r, "single ball");
+  }
+}
+
+// Balls centred on the z axis (a crease segment, e.g. a wedge edge), each
+// crossing the next (|c₁c₂|² ≤ r₁² + r₂²: smooth, Lemma 14), non-consecutive
+// ones disjoint.
+void ChainScene(Scene* s) {
+  s->balls = {{Vec3(0, 0, -1.3), 0.55}, {Vec3(0, 0, -0.55), 0.6}, {Vec3(0, 0, 0.25), 0.65},
+              {Vec3(0, 0, 1.05), 0.6}};
+  s->crease_edges = {{0, 1}, {1, 2}, {2, 3}};
+}
+
+TEST(RipStitchTest, ChainOnSegment) {
+  for (uint64_t seed : {4, 5}) {
+    Scene s;
+    ChainScene(&s);
+    BuildScene(&s, 0.2, seed);
+    std::vector<StitchFailure> fails;
+    const absl::StatusOr<StitchResult> r = RipStitchCollar(InputOf(s), &fails);
+    ASSERT_TRUE(r.ok()) << r.status() << "\n" << Describe(fails);
+    EXPECT_GT(r->books, 3 * 12u);
+    CheckMesh(s, *r, "chain of 4 balls");
+  }
+}
+
+// A vertex ball at the origin and two segment chains leaving it at 30°
+// (radius t/6 at distance t: g/3 with g the distance to the other segment).
+void VertexScene(Scene* s) {
+  const double half = 15 * std::numbers::pi / 180;
+  const Vec3 d1(std::cos(half), std::sin(half), 0), d2(std::cos(half), -std::sin(half), 0);
+  const Vec3 o(-1.2, 0, 0.1);
+  s->balls = {{o, 1.0}};
+  const double t[3] = {1.05, 1.30, 1.62}, r[3] = {0.17, 0.20, 0.25};
+  for (const Vec3& d : {d1, d2}) {
+    const uint32_t first = static_cast<uint32_t>(s->balls.size());
+    for (int k = 0; k < 3; ++k) s->balls.push_back({o + t[k] * d, r[k]});
+    s->crease_edges.push_back({0, first});
+    s->crease_edges.push_back({first, first + 1});
+    s->crease_edges.push_back({first + 1, first + 2});
+  }
+}
+
+TEST(RipStitchTest, VertexBallWithTwoChainsAt30Degrees) {
+  Scene s;
+  VertexScene(&s);
+  BuildScene(&s, 0.2, 6);
+  std::vector<StitchFailure> fails;
+  const absl::StatusOr<StitchResult> r = RipStitchCollar(InputOf(s), &fails);
+  ASSERT_TRUE(r.ok()) << r.status() << "\n" << Describe(fails);
+  CheckMesh(s, *r, "vertex ball + two chains at 30 deg");
+}
+
+TEST(RipStitchTest, SparseSampleIsRefusedWithLocationsOnS) {
+  // Six random points of the sphere: RepBalls far larger than ε_s·ρ.
+  Scene s;
+  const CollarBall ball{Vec3(0.1, -0.2, 0.05), 1.0};
+  s.balls = {ball};
+  s.stitch_balls.push_back({ball, s.Add(ball.center)});
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> n(0, 1);
+  for (int i = 0; i < 6; ++i) {
+    const Vec3 d(n(rng), n(rng), n(rng));
+    s.Add(ball.center + d / geom::Norm(d));
+  }
+  for (int c = 0; c < 8; ++c) s.Add(Vec3(c & 1 ? 4 : -4, c & 2 ? 4 : -4, c & 4 ? 4 : -4));
+  std::vector<StitchFailure> fails;
+  const absl::StatusOr<StitchResult> r = RipStitchCollar(InputOf(s), &fails);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_NE(r.status().message().find(" at ("), std::string::npos) << r.status();
+  ASSERT_FALSE(fails.empty());
+  int on_sphere = 0;
+  for (const StitchFailure& f : fails) {
+    EXPECT_EQ(f.ball, 0u);
+    if (std::fabs(geom::Dist(f.where, ball.center) - ball.radius) < 1e-9) ++on_sphere;
+  }
+  EXPECT_GT(on_sphere, 0) << Describe(fails);
+}
+
+TEST(RipStitchTest, HemisphereSampleIsRefusedStructurally) {
+  // Samples only on z > 0.2: the crease vertex's cell leaves the ball below.
+  // With the quality checks off the refusal is structural.
+  Scene s;
+  const CollarBall ball{Vec3(0, 0, 0), 1.0};
+  s.balls = {ball};
+  s.stitch_balls.push_back({ball, s.Add(ball.center)});
+  for (const Vec3& d : SpiralDirections(300, 3)) {
+    if (d.z > 0.2) s.Add(d);
+  }
+  for (int c = 0; c < 8; ++c) s.Add(Vec3(c & 1 ? 4 : -4, c & 2 ? 4 : -4, c & 4 ? 4 : -4));
+  StitchInput in = InputOf(s);
+  in.options.max_rep_angle = std::numbers::pi / 2;
+  in.options.max_rep_ratio = std::numeric_limits<double>::infinity();
+  std::vector<StitchFailure> fails;
+  const absl::StatusOr<StitchResult> r = RipStitchCollar(in, &fails);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), absl::StatusCode::kFailedPrecondition);
+  bool crease_vertex = false;
+  for (const StitchFailure& f : fails) {
+    EXPECT_NE(f.kind, StitchFailure::Kind::kLargeAngle);
+    EXPECT_NE(f.kind, StitchFailure::Kind::kCoarseSample);
+    if (f.kind == StitchFailure::Kind::kCreaseVertexOnSurface) {
+      crease_vertex = true;
+      // Located on S (a representation point) unless no face carried it.
+      EXPECT_NEAR(geom::Dist(f.where, ball.center), 1.0, 1e-9) << f.detail;
+    }
+  }
+  EXPECT_TRUE(crease_vertex) << Describe(fails);
+}
+
+TEST(RipStitchTest, UnlistedCrossingPairIsRefused) {
+  Scene s;
+  ChainScene(&s);
+  BuildScene(&s, 0.2, 4);
+  s.crease_edges.pop_back();  // balls 2 and 3 still cross
+  std::vector<StitchFailure> fails;
+  const absl::StatusOr<StitchResult> r = RipStitchCollar(InputOf(s), &fails);
+  ASSERT_FALSE(r.ok());
+  bool unlisted = false;
+  for (const StitchFailure& f : fails) {
+    if (f.kind != StitchFailure::Kind::kUnlistedCircle) continue;
+    unlisted = true;
+    EXPECT_EQ(f.ball, 2u);
+    // A point of the circle of balls 2 and 3: on both spheres.
+    EXPECT_NEAR(geom::Dist(f.where, s.balls[2].center), s.balls[2].radius, 1e-9);
+    EXPECT_NEAR(geom::Dist(f.where, s.balls[3].center), s.balls[3].radius, 1e-9);
+  }
+  EXPECT_TRUE(unlisted) << Describe(fails);
+}
+
+}  // namespace
+}  // namespace svrc::refine
