@@ -265,6 +265,248 @@ TEST(LocationGraphTest, RandomizedValidate) {
   EXPECT_EQ(a, run());
 }
 
+// The reference model for the BLG's iteration order: every link ever added,
+// in AddLink order, with a live flag. Each answer of the graph (BallsOf,
+// ObjectsOf, CellsOf, the lists RemoveCellLinks / RemoveObjectLinks report) is
+// the live links filtered, in that order: the refiner's output bytes depend on
+// it (issue #5 replaced the linked lists by arrays with order-keeping removal).
+struct BlgModel {
+  struct Link {
+    MeshId mesh;
+    uint32_t cell;
+    LocationObject object;
+    bool unresolved;
+    LinkId id;
+    bool live;
+  };
+  std::vector<Link> links;
+
+  Link* Find(MeshId m, uint32_t c, LocationObject o) {
+    for (Link& l : links) {
+      if (l.live && l.mesh == m && l.cell == c && l.object == o) return &l;
+    }
+    return nullptr;
+  }
+  bool IsLinked(MeshId m, uint32_t c, LocationObject o) const {
+    return std::any_of(links.begin(), links.end(), [&](const Link& l) {
+      return l.live && l.mesh == m && l.cell == c && l.object == o;
+    });
+  }
+  std::vector<LocationObject> Objects(MeshId m, uint32_t c) const {
+    std::vector<LocationObject> out;
+    for (const Link& l : links) {
+      if (l.live && l.mesh == m && l.cell == c) out.push_back(l.object);
+    }
+    return out;
+  }
+  std::vector<uint32_t> Cells(LocationObject o, MeshId m) const {
+    std::vector<uint32_t> out;
+    for (const Link& l : links) {
+      if (l.live && l.object == o && (!m.valid() || l.mesh == m)) out.push_back(l.cell);
+    }
+    return out;
+  }
+  uint32_t NumLive() const {
+    return static_cast<uint32_t>(std::count_if(links.begin(), links.end(), [](const Link& l) { return l.live; }));
+  }
+};
+
+// Compares every query of `g` with the model over the whole id range.
+void ExpectSameAsModel(const LocationGraph& g, const BlgModel& model, int meshes, uint32_t cells,
+                       uint32_t balls, uint32_t collars, int step) {
+  ASSERT_EQ(g.NumLinks(), model.NumLive()) << "step " << step;
+  for (int m = 0; m < meshes; ++m) {
+    for (uint32_t c = 0; c < cells; ++c) {
+      const std::vector<LocationObject> want = model.Objects(MeshId(m), c);
+      std::vector<LocationObject> got;
+      g.ObjectsOf(MeshId(m), c, &got);
+      ASSERT_EQ(got, want) << "ObjectsOf mesh " << m << " cell " << c << " step " << step;
+      std::vector<BallId> want_balls, got_balls;
+      uint32_t want_unresolved = 0;
+      for (const BlgModel::Link& l : model.links) {
+        if (!l.live || l.mesh != MeshId(m) || l.cell != c) continue;
+        if (l.object.kind == ObjectKind::kBall) want_balls.push_back(BallId(l.object.id));
+        if (l.unresolved) ++want_unresolved;
+      }
+      g.BallsOf(MeshId(m), c, &got_balls);
+      ASSERT_EQ(got_balls, want_balls) << "BallsOf mesh " << m << " cell " << c << " step " << step;
+      ASSERT_EQ(g.NumUnresolved(MeshId(m), c), want_unresolved) << "mesh " << m << " cell " << c;
+    }
+  }
+  for (uint32_t kind = 0; kind < 2; ++kind) {
+    for (uint32_t id = 0; id < (kind == 0 ? balls : collars); ++id) {
+      const LocationObject o{static_cast<ObjectKind>(kind), id};
+      for (int m = 0; m < meshes; ++m) {
+        std::vector<uint32_t> got;
+        g.CellsOf(o, MeshId(m), &got);
+        ASSERT_EQ(got, model.Cells(o, MeshId(m))) << "CellsOf kind " << kind << " id " << id << " mesh " << m;
+        for (uint32_t c = 0; c < cells; ++c) {
+          ASSERT_EQ(g.IsLinked(MeshId(m), c, o), model.IsLinked(MeshId(m), c, o));
+        }
+      }
+    }
+  }
+}
+
+// Random sequences of every mutating call, checked step by step against the
+// model: identical iteration orders after order-keeping removals from the
+// front, middle and back of arrays, after arrays grow past several block
+// sizes (one cell and one ball collect > 64 links) and after emptied blocks
+// are reused by other cells and objects.
+TEST(LocationGraphTest, MatchesReferenceModelOrder) {
+  constexpr int kMeshes = 3;
+  constexpr uint32_t kCells = 12, kBalls = 24, kCollars = 3;
+  LocationGraph g;
+  BallStore balls;
+  for (uint32_t i = 0; i < kBalls; ++i) {
+    balls.AddVertexBall(PointId(i), {0, 0, 0}, FeatureId(i), MeshId(1), kCdInputVertex);
+  }
+  BlgModel model;
+  std::mt19937 rng(7);
+  auto random_object = [&] {
+    return rng() % 8 == 0 ? LocationObject::Collar(rng() % kCollars) : LocationObject::Ball(BallId(rng() % kBalls));
+  };
+  uint64_t removed_total = 0;
+  for (int step = 0; step < 6000; ++step) {
+    // Phases: mostly adds (arrays grow), then mixed, then mostly removals.
+    const int phase = step / 2000;
+    const uint32_t op = rng() % 16;
+    const MeshId m(rng() % kMeshes);
+    const uint32_t c = rng() % kCells;
+    const LocationObject o = random_object();
+    const bool add = phase == 0 ? op < 13 : phase == 1 ? op < 8 : op < 4;
+    if (add) {
+      LinkFacts f;
+      f.unresolved = rng() % 3 == 0;
+      const AddLinkResult r = g.AddLink(m, c, o, f, &balls);
+      BlgModel::Link* existing = model.Find(m, c, o);
+      ASSERT_EQ(r.link.valid(), existing == nullptr) << "step " << step;
+      if (existing == nullptr) {
+        uint32_t unresolved_before = 0;
+        for (const BlgModel::Link& l : model.links) unresolved_before += l.live && l.mesh == m && l.cell == c && l.unresolved;
+        EXPECT_EQ(r.cell_became_unresolved, f.unresolved && unresolved_before == 0);
+        model.links.push_back({m, c, o, f.unresolved, r.link, true});
+      }
+    } else {
+      switch (op % 4) {
+        case 0: {  // by (mesh, cell, object)
+          BlgModel::Link* l = model.Find(m, c, o);
+          ASSERT_EQ(g.RemoveLink(m, c, o), l != nullptr);
+          if (l != nullptr) l->live = false, ++removed_total;
+          break;
+        }
+        case 1: {  // by LinkId: a random live link
+          std::vector<BlgModel::Link*> live;
+          for (BlgModel::Link& l : model.links) {
+            if (l.live) live.push_back(&l);
+          }
+          if (live.empty()) break;
+          BlgModel::Link* l = live[rng() % live.size()];
+          g.RemoveLink(l->id);
+          l->live = false;
+          ++removed_total;
+          break;
+        }
+        case 2: {  // a whole cell, reported in link order
+          std::vector<LocationObject> got;
+          g.RemoveCellLinks(m, c, &got);
+          ASSERT_EQ(got, model.Objects(m, c)) << "RemoveCellLinks step " << step;
+          for (BlgModel::Link& l : model.links) {
+            if (l.live && l.mesh == m && l.cell == c) l.live = false, ++removed_total;
+          }
+          break;
+        }
+        case 3: {  // a whole object, in one mesh or in all
+          const MeshId which = rng() % 2 ? m : kNoneMesh;
+          std::vector<uint32_t> got;
+          g.RemoveObjectLinks(o, which, &got);
+          ASSERT_EQ(got, model.Cells(o, which)) << "RemoveObjectLinks step " << step;
+          for (BlgModel::Link& l : model.links) {
+            if (l.live && l.object == o && (!which.valid() || l.mesh == which)) l.live = false, ++removed_total;
+          }
+          break;
+        }
+      }
+    }
+    if (step % 97 == 0 || step == 5999) {
+      ASSERT_TRUE(g.Validate()) << "step " << step;
+      ASSERT_NO_FATAL_FAILURE(ExpectSameAsModel(g, model, kMeshes, kCells, kBalls, kCollars, step));
+    }
+  }
+  EXPECT_EQ(g.stats().links_removed, removed_total);
+  EXPECT_EQ(g.stats().links_added, model.links.size());
+
+  // Long arrays: one cell and one ball collect many links (several block
+  // growths); removing every third link keeps the rest in order.
+  const MeshId m(1);
+  for (uint32_t i = 0; i < kBalls; ++i) g.RemoveObjectLinks(LocationObject::Ball(BallId(i)), kNoneMesh, nullptr);
+  for (uint32_t i = 0; i < kCollars; ++i) g.RemoveObjectLinks(LocationObject::Collar(i), kNoneMesh, nullptr);
+  ASSERT_EQ(g.NumLinks(), 0u);
+  std::vector<uint32_t> want_cells;
+  for (uint32_t c = 100; c < 200; ++c) {
+    g.AddLink(m, c, LocationObject::Ball(BallId(5)), {}, &balls);
+    want_cells.push_back(c);
+  }
+  std::vector<BallId> want_balls;
+  for (uint32_t b = 0; b < kBalls; ++b) {
+    const uint32_t id = (b * 7) % kBalls;  // not in id order
+    g.AddLink(m, 150, LocationObject::Ball(BallId(id)), {}, &balls);
+    if (id != 5) want_balls.push_back(BallId(id));
+  }
+  for (uint32_t k = 0; k < 70; ++k) g.AddLink(m, 150, LocationObject::Collar(k), {}, &balls);
+  std::vector<BallId> got_balls;
+  g.BallsOf(m, 150, &got_balls);
+  std::vector<BallId> first_balls = want_balls;
+  first_balls.insert(first_balls.begin() + 0, BallId(5));  // ball 5's link to cell 150 came first
+  EXPECT_EQ(got_balls, first_balls);
+  for (size_t i = 0; i < want_cells.size(); i += 3) {
+    ASSERT_TRUE(g.RemoveLink(m, want_cells[i], LocationObject::Ball(BallId(5))));
+  }
+  std::vector<uint32_t> kept_cells;
+  for (size_t i = 0; i < want_cells.size(); ++i) {
+    if (i % 3 != 0) kept_cells.push_back(want_cells[i]);
+  }
+  std::vector<uint32_t> got_cells;
+  g.CellsOf(LocationObject::Ball(BallId(5)), m, &got_cells);
+  EXPECT_EQ(got_cells, kept_cells);
+  // Cell 150 (index 50, 50 % 3 != 0) still has ball 5 first.
+  got_balls.clear();
+  g.BallsOf(m, 150, &got_balls);
+  EXPECT_EQ(got_balls, first_balls);
+  for (uint32_t k = 0; k < 70; k += 2) ASSERT_TRUE(g.RemoveLink(m, 150, LocationObject::Collar(k)));
+  std::vector<LocationObject> objs;
+  g.ObjectsOf(m, 150, &objs);
+  ASSERT_EQ(objs.size(), first_balls.size() + 35);
+  for (size_t i = 0; i < first_balls.size(); ++i) EXPECT_EQ(objs[i], LocationObject::Ball(first_balls[i]));
+  for (uint32_t k = 0; k < 35; ++k) EXPECT_EQ(objs[first_balls.size() + k], LocationObject::Collar(2 * k + 1));
+  EXPECT_TRUE(g.Validate());
+}
+
+// LinkIds stay valid handles while their link lives, whatever else is removed
+// (records are recycled only after their own link goes).
+TEST(LocationGraphTest, LinkIdRemovesItsOwnLink) {
+  LocationGraph g;
+  BallStore balls;
+  for (uint32_t i = 0; i < 4; ++i) balls.AddVertexBall(PointId(i), {0, 0, 0}, FeatureId(i), MeshId(1), kCdInputVertex);
+  const MeshId m = kOmegaMesh;
+  const LinkId a = g.AddLink(m, 0, LocationObject::Ball(BallId(0)), {}, &balls).link;
+  const LinkId b = g.AddLink(m, 0, LocationObject::Ball(BallId(1)), {}, &balls).link;
+  const LinkId c = g.AddLink(m, 1, LocationObject::Ball(BallId(1)), {}, &balls).link;
+  g.RemoveLink(a);
+  const LinkId d = g.AddLink(m, 2, LocationObject::Ball(BallId(2)), {}, &balls).link;  // may reuse a's record
+  g.RemoveLink(c);
+  EXPECT_TRUE(g.IsLinked(m, 0, LocationObject::Ball(BallId(1))));
+  EXPECT_FALSE(g.IsLinked(m, 1, LocationObject::Ball(BallId(1))));
+  EXPECT_TRUE(g.IsLinked(m, 2, LocationObject::Ball(BallId(2))));
+  g.RemoveLink(b);
+  g.RemoveLink(d);
+  EXPECT_EQ(g.NumLinks(), 0u);
+  EXPECT_TRUE(g.Validate());
+  std::vector<uint32_t> cells;
+  g.CellsOf(LocationObject::Ball(BallId(1)), m, &cells);
+  EXPECT_TRUE(cells.empty());
+}
+
 TEST(NormalizeTest, FarOffsetBoxRoundTripsExactly) {
   // far_offset_close_points: a 1000-box at 1e6 with two points 1e-3 apart.
   std::vector<Vec3> pts = {{1e6, 1e6, 1e6}, {1001000.0, 1001000.0, 1001000.0},
