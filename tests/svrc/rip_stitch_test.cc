@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <set>
@@ -62,6 +63,13 @@ double UnionGap(const Vec3& p, const std::vector<CollarBall>& balls) {
   return g;
 }
 
+// The guide's css(p) = min_j max(ρ_j, |p c_j|) (1-Lipschitz, ≤ rad, Def 32).
+double Css(const Vec3& p, const std::vector<CollarBall>& balls) {
+  double c = std::numeric_limits<double>::infinity();
+  for (const CollarBall& b : balls) c = std::min(c, std::max(b.radius, geom::Dist(p, b.center)));
+  return c;
+}
+
 // A refined mesh around a collar system as the refiner would leave it: the
 // crease vertices (ball centres), samples of every circle and partial sphere
 // at spacing ≈ h·ρ (a third of the sphere samples radially jittered by
@@ -97,20 +105,38 @@ void BuildScene(Scene* s, double h, uint64_t seed) {
   for (uint32_t i = 0; i < balls.size(); ++i) {
     const CollarBall& b = balls[i];
     const int n = static_cast<int>(std::ceil(4 * std::numbers::pi / (h * h)));
+    // Spacing ≈ h·css(p) (Definition 33 asks |s M| ≤ ε·css(s)): a fine spiral
+    // thinned greedily, so the sphere of a big ball is denser next to small
+    // balls crossing it.
+    double cmin = b.radius;
+    for (const CollarBall& o : balls) {
+      if (geom::Dist(o.center, b.center) < o.radius + b.radius) cmin = std::min(cmin, o.radius);
+    }
+    const int n_fine = static_cast<int>(std::ceil(4 * std::numbers::pi / std::pow(h * cmin / b.radius, 2)));
+    std::vector<Vec3> kept;
     int k = 0;
-    for (const Vec3& d : SpiralDirections(n, seed * 31 + i)) {
+    for (const Vec3& d : SpiralDirections(n_fine, seed * 31 + i)) {
       Vec3 p = b.center + b.radius * d;
+      const double target = 0.85 * h * Css(p, balls);
       bool keep = true;
-      for (uint32_t j = 0; j < balls.size(); ++j) {
-        if (j != i && geom::Dist(p, balls[j].center) - balls[j].radius < 0.5 * h * b.radius) keep = false;
-      }
-      for (const Circle3& c : circles) {
-        if (DistToCircle(p, c) < 0.6 * h * b.radius) keep = false;
+      for (const Vec3& q : kept) {
+        if (geom::Dist2(p, q) < target * target) {
+          keep = false;
+          break;
+        }
       }
       if (!keep) continue;
+      for (uint32_t j = 0; j < balls.size(); ++j) {
+        if (j != i && geom::Dist(p, balls[j].center) - balls[j].radius < 0.6 * target) keep = false;
+      }
+      for (const Circle3& c : circles) {
+        if (DistToCircle(p, c) < 0.7 * target) keep = false;
+      }
+      if (!keep) continue;
+      kept.push_back(b.center + b.radius * d);
       if (k++ % 3 == 0) {
         const double j = (0.01 + 0.02 * u01(rng)) * (u01(rng) < 0.5 ? -1 : 1);
-        p = b.center + b.radius * (1 + j) * d;
+        p = b.center + (b.radius + j * Css(p, balls)) * d;  // 1–3 % of the local size
       }
       s->Add(p);
     }
@@ -305,14 +331,16 @@ TEST(RipStitchTest, ChainOnSegment) {
   }
 }
 
-// A vertex ball at the origin and two segment chains leaving it at 30°
-// (radius t/6 at distance t: g/3 with g the distance to the other segment).
+// A vertex ball and two segment chains leaving its centre at 30°.
 void VertexScene(Scene* s) {
   const double half = 15 * std::numbers::pi / 180;
   const Vec3 d1(std::cos(half), std::sin(half), 0), d2(std::cos(half), -std::sin(half), 0);
   const Vec3 o(-1.2, 0, 0.1);
   s->balls = {{o, 1.0}};
-  const double t[3] = {1.05, 1.30, 1.62}, r[3] = {0.17, 0.20, 0.25};
+  // Consecutive balls cross with |c₁c₂|² ≤ r₁² + r₂² (smooth, Lemma 14); the
+  // second ball of a chain stays clear of the vertex ball; balls of the two
+  // chains are disjoint (r ≤ g/2 with g = t·sin 30°, Lemma 13).
+  const double t[3] = {1.0, 1.30, 1.65}, r[3] = {0.20, 0.23, 0.27};
   for (const Vec3& d : {d1, d2}) {
     const uint32_t first = static_cast<uint32_t>(s->balls.size());
     for (int k = 0; k < 3; ++k) s->balls.push_back({o + t[k] * d, r[k]});
