@@ -100,7 +100,10 @@ struct ArcOptions {
   // Ch. 6): repair a restricted edge whose RepBall radius exceeds
   // eps·(its circle's radius) — the in-plane circle radius, which bounds the
   // angle a chord subtends at the circle's centre by 4·asin(eps/2). 0: off.
-  double eps = 0;
+  // Default 1 (≤ 120°, the chords of an inscribed triangle): consistency
+  // alone accepts one chord for a 263° arc, and the fan (crease point, chord)
+  // of RipStitchCollar is on the wrong side of a chord subtending > 180°.
+  double eps = 1;
 };
 
 // A restricted Delaunay edge of an arc (Definition 28 in 2D): the Voronoi edge

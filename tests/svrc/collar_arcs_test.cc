@@ -407,6 +407,39 @@ TEST(CollarArcs, OffArcVertexIsRepaired) {
   EXPECT_EQ(rep.off_arc_edges, 0);
 }
 
+TEST(CollarArcs, ConsistencyAloneAcceptsOneChordForALongArc) {
+  // Line of three balls: the outer arcs span 262.8°. The thesis' criteria
+  // (consistency + σ) accept the single chord between their (2,1) ends; the
+  // default size test (eps = 1) makes every chord subtend ≤ 120°.
+  const plc::FacetFrame f = TiltedFrame();
+  const auto balls = LineInPlane(f);
+  const FacetCollarSystem sys = FacetCollars(f, balls);
+  ArcOptions pure;
+  pure.require_on_arc = false;
+  pure.eps = 0;
+  Mesh m1;
+  ASSERT_TRUE(Drive(f, balls, sys, kPi / 12, &m1, pure).converged);
+  Mesh m2;
+  ASSERT_TRUE(Drive(f, balls, sys, kPi / 12, &m2).converged);
+  const auto c1 = ArcChains(m1.dt, sys);
+  const auto c2 = ArcChains(m2.dt, sys);
+  for (uint32_t a = 0; a < sys.arcs.size(); ++a) {
+    if (sys.arcs[a].length < kPi) continue;
+    EXPECT_NEAR(sys.arcs[a].length * 180 / kPi, 262.8, 0.1);
+    EXPECT_TRUE(c1[a].complete);
+    EXPECT_EQ(c1[a].vertices.size(), 2u);
+    EXPECT_TRUE(c2[a].complete);
+    const PlaneCircle& c = sys.circles[sys.arcs[a].circle];
+    for (size_t i = 0; i + 1 < c2[a].vertices.size(); ++i) {
+      const Vec2 p = m2.dt.Point(c2[a].vertices[i]) - c.center;
+      const Vec2 q = m2.dt.Point(c2[a].vertices[i + 1]) - c.center;
+      const double sub = std::atan2(p.x * q.y - p.y * q.x, p.x * q.x + p.y * q.y);
+      EXPECT_GT(sub, 0);  // counter-clockwise along the arc
+      EXPECT_LE(sub, 2 * kPi / 3 + 1e-12);
+    }
+  }
+}
+
 // --- The iterative driver on the scenarios (i)–(iv) -------------------------
 
 struct Scenario {
@@ -431,9 +464,10 @@ TEST_P(CollarArcsDrive, ConvergesToAConsistentSampleWithChords) {
   };
   ArcOptions pure;
   pure.require_on_arc = false;
+  pure.eps = 0;
   ArcOptions sized;
   sized.eps = 0.5;
-  const Mode modes[] = {{"on_arc", ArcOptions{}, true},
+  const Mode modes[] = {{"on_arc+eps1", ArcOptions{}, true},
                         {"on_arc+eps0.5", sized, true},
                         {"thesis_only", pure, false}};
   for (const Mode& mode : modes) {
