@@ -463,15 +463,12 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
   // balls), and with them the size criterion alone left (a)–(c) violations
   // even at ε_s = 0.07 (docs/svrc-collars.md, stage (e) measurements).
   const bool explicit_tests = !opt.size_criterion;
-  auto add_topo = [&](const Vec3& x, uint32_t ball, uint32_t circle, CollarRepair::Reason why) {
-    add(x, ball, circle, why);
-  };
 
   // (a) one root per Voronoi edge.
   for (const Unique& u : uniq) {
     if (u.roots == 1) continue;
     ++rep.bad_roots;
-    add_topo(tris[u.best].x, tris[u.best].ball, CollarRepair::kNoCircle, CollarRepair::kTopology);
+    add(tris[u.best].x, tris[u.best].ball, CollarRepair::kNoCircle, CollarRepair::kTopology);
   }
   // (b) every Delaunay edge in 0 or 2 restricted triangles of S.
   std::vector<std::pair<uint64_t, uint32_t>> edge_tri;  // edge → unique index
@@ -492,7 +489,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     }
     if (j - i != 2) {
       ++rep.bad_facets;
-      add_topo(tris[best].x, tris[best].ball, CollarRepair::kNoCircle, CollarRepair::kTopology);
+      add(tris[best].x, tris[best].ball, CollarRepair::kNoCircle, CollarRepair::kTopology);
     }
     i = j;
   }
@@ -546,7 +543,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       if (dt.NearestVertex(x, dt.VertexTet(VertexId(v))) != VertexId(v)) continue;
       consider(x, bi, CollarRepair::kNoCircle);
     }
-    if (best_d > 0) add_topo(best_x, best_ball, best_circle, CollarRepair::kTopology);
+    if (best_d > 0) add(best_x, best_ball, best_circle, CollarRepair::kTopology);
   };
   // (c) every vertex's restricted link in S is one cycle.
   {
@@ -653,12 +650,12 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       } else if (kb < kc) {
         ++rep.bad_boundaries;
         const RestrictedTriangle& t = tris[boundary[p].second];
-        add_topo(t.x, t.ball, CollarRepair::kNoCircle, CollarRepair::kTopology);
+        add(t.x, t.ball, CollarRepair::kNoCircle, CollarRepair::kTopology);
         ++p;
       } else {
         ++rep.bad_boundaries;
         const uint32_t k = std::get<1>(ce[q]);
-        add_topo(res.circle_edges[k][std::get<2>(ce[q])].x, bi, k, CollarRepair::kCircle);
+        add(res.circle_edges[k][std::get<2>(ce[q])].x, bi, k, CollarRepair::kCircle);
         while (q < ce.size() && std::get<0>(ce[q]) == kc) ++q;
       }
     }

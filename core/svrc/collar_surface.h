@@ -121,9 +121,10 @@ struct CollarSurfaceReport {
 double CollarSurfaceSize(const Vec3& x, const CollarDescription& collars);
 
 // The COLLAR events of `dt` against `collars`, largest radius first (ties:
-// reason, ball, x), each point once. Empty iff the vertices are a
-// collar-consistent sample with every representation angle ≤ σ (or, with
-// size_criterion, every RepBall within ε_s·css). `report` may be null.
+// reason, ball, x), each point once. Empty iff the vertices pass (a)–(f)
+// (a collar-consistent sample, as far as these tests see) and every
+// representation angle is ≤ σ (with size_criterion: every RepBall radius is
+// ≤ ε_s·css(x) instead of the angle bound). `report` may be null.
 std::vector<CollarRepair> CollarRepairs(const delaunay::Delaunay3& dt,
                                         const CollarDescription& collars,
                                         const CollarSurfaceOptions& opt,
