@@ -42,6 +42,12 @@ void LocationGraph::Arena<Entry>::Erase(Span& s, uint32_t i) {
   --s.size;
 }
 
+template <typename Entry>
+void LocationGraph::Arena<Entry>::Release(Span& s) {
+  if (s.cap != 0) free_[std::countr_zero(s.cap)].push_back(s.offset);
+  s = Span{};
+}
+
 LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
   if (cell_spans_.size() <= mesh.value()) {
     cell_spans_.resize(mesh.value() + 1);
@@ -220,6 +226,7 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
     ++stats_.links_removed;
   }
   os.size = kept;
+  if (kept == 0) object_arena_.Release(os);
 }
 
 void LocationGraph::BallsOf(MeshId mesh, uint32_t cell, std::vector<BallId>* out) const {

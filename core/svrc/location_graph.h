@@ -107,8 +107,9 @@ class LocationGraph {
   };
   // Blocks of small arrays in one vector. A full block moves to a block of
   // twice its capacity (taken from that size's free list, else appended); the
-  // old block goes to its free list. Blocks of emptied arrays are kept: a cell
-  // emptied by UpdateLocation is usually refilled at once.
+  // old block goes to its free list. Blocks of emptied arrays are kept (a cell
+  // emptied by UpdateLocation is usually refilled at once) except a dead
+  // object's (RemoveObjectLinks): ball ids are not reused.
   template <typename Entry>
   class Arena {
    public:
@@ -118,6 +119,8 @@ class LocationGraph {
     void Append(Span& s, const Entry& e);
     // Removes entry `i` of `s`, shifting the later entries down (order kept).
     void Erase(Span& s, uint32_t i);
+    // Returns the block of an empty array to its free list.
+    void Release(Span& s);
 
    private:
     std::vector<Entry> pool_;
