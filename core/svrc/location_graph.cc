@@ -106,9 +106,9 @@ bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) 
 
 uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t cell) {
   uint32_t l;
-  if (free_record_ != kNil) {
-    l = free_record_;
-    free_record_ = records_[l].mesh;
+  if (!free_records_.empty()) {
+    l = free_records_.back();
+    free_records_.pop_back();
   } else {
     l = static_cast<uint32_t>(records_.size());
     records_.emplace_back();
@@ -117,11 +117,7 @@ uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t c
   return l;
 }
 
-void LocationGraph::FreeRecord(uint32_t l) {
-  records_[l].cell = kNil;
-  records_[l].mesh = free_record_;
-  free_record_ = l;
-}
+void LocationGraph::FreeRecord(uint32_t l) { free_records_.push_back(l); }
 
 AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject object,
                                      const LinkFacts& facts, BallStore* balls) {
@@ -166,8 +162,15 @@ void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshI
 void LocationGraph::RemoveLink(LinkId id) {
   if (!id.valid() || id.value() >= records_.size()) return;
   const LinkRecord rec = records_[id.value()];
-  if (rec.cell == kNil) return;
-  RemoveLink(MeshId(rec.mesh), rec.cell, rec.object);
+  const MeshId mesh(rec.mesh);
+  // A freed record keeps its old ends: act only if the link still lives.
+  const Span* cs = FindCellSpan(mesh, rec.cell);
+  const Span* os = FindObjectSpan(rec.object);
+  if (cs == nullptr || os == nullptr) return;
+  const uint32_t oi = ObjectPos(*os, mesh, rec.cell);
+  if (oi == kNil || object_arena_.Data(*os)[oi].link != id.value()) return;
+  const uint32_t ci = CellPos(*cs, rec.object);
+  RemoveAt(cell_spans_[rec.mesh][rec.cell], ci, ObjectSpan(rec.object), oi, mesh, rec.cell);
 }
 
 bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object) {
@@ -313,16 +316,17 @@ bool LocationGraph::Validate() const {
       }
     }
   }
-  // Live records are exactly the ones both sides reached; free ones neither.
-  uint32_t free_count = 0;
-  for (uint32_t l = free_record_; l != kNil; l = records_[l].mesh) {
-    if (l >= records_.size() || records_[l].cell != kNil || ++free_count > records_.size()) return false;
+  // Every record is either live (reached once from each side) or on the free
+  // stack once (reached from neither).
+  std::vector<uint8_t> is_free(records_.size(), 0);
+  for (uint32_t l : free_records_) {
+    if (l >= records_.size() || is_free[l]++) return false;
   }
   for (uint32_t l = 0; l < records_.size(); ++l) {
-    const bool live = records_[l].cell != kNil;
-    if (live != (seen_cell[l] == 1) || live != (seen_obj[l] == 1)) return false;
+    const bool live = seen_cell[l] == 1 && seen_obj[l] == 1;
+    if (live == (is_free[l] == 1) || (!live && (seen_cell[l] != 0 || seen_obj[l] != 0))) return false;
   }
-  return count == num_links_ && free_count + num_links_ == records_.size();
+  return count == num_links_ && free_records_.size() + num_links_ == records_.size();
 }
 
 }  // namespace svrc::refine

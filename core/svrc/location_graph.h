@@ -141,8 +141,9 @@ class LocationGraph {
     uint32_t cell = 0;
     uint32_t link = 0;
   };
-  // LinkId → its ends (RemoveLink(LinkId), Validate). cell == kNil: free, and
-  // `mesh` holds the next free record.
+  // LinkId → its ends (RemoveLink(LinkId), Validate). Freeing a record only
+  // pushes its id on a stack; a LinkId is live iff its object's entry for
+  // (mesh, cell) names it, so a stale id removes nothing.
   struct LinkRecord {
     LocationObject object;
     uint32_t mesh = kNil;
@@ -166,7 +167,7 @@ class LocationGraph {
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;
   std::vector<LinkRecord> records_;
-  uint32_t free_record_ = kNil;
+  std::vector<uint32_t> free_records_;  // LIFO: the next link reuses the last freed id
   uint32_t num_links_ = 0;
   std::vector<std::vector<Span>> cell_spans_;      // [mesh][cell]
   std::vector<std::vector<uint32_t>> unresolved_;  // [mesh][cell]

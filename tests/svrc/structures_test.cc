@@ -505,6 +505,21 @@ TEST(LocationGraphTest, LinkIdRemovesItsOwnLink) {
   std::vector<uint32_t> cells;
   g.CellsOf(LocationObject::Ball(BallId(1)), m, &cells);
   EXPECT_TRUE(cells.empty());
+  // A stale id (its link removed) removes nothing, even when the same
+  // (mesh, cell, object) is linked again under another id.
+  const LinkId x = g.AddLink(m, 5, LocationObject::Ball(BallId(3)), {}, &balls).link;
+  const LinkId y = g.AddLink(m, 6, LocationObject::Ball(BallId(3)), {}, &balls).link;
+  g.RemoveLink(x);
+  g.RemoveLink(x);
+  g.RemoveLink(y);
+  const LinkId again = g.AddLink(m, 5, LocationObject::Ball(BallId(3)), {}, &balls).link;
+  ASSERT_TRUE(again.valid());
+  ASSERT_NE(again, x);
+  g.RemoveLink(x);
+  EXPECT_TRUE(g.IsLinked(m, 5, LocationObject::Ball(BallId(3))));
+  EXPECT_EQ(g.NumLinks(), 1u);
+  EXPECT_EQ(g.stats().links_removed, 6u);
+  EXPECT_TRUE(g.Validate());
 }
 
 TEST(NormalizeTest, FarOffsetBoxRoundTripsExactly) {
