@@ -6,13 +6,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <optional>
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
 #include "core/geometry/predicates.h"
 #include "core/plc/features.h"
+#include "core/plc/intersect.h"
 #include "core/svrc/balls.h"
+#include "core/svrc/collar_index.h"
+#include "core/svrc/collar_size.h"
 #include "core/svrc/containment.h"
 #include "core/svrc/facet_mesh.h"
 #include "core/svrc/feature_meshes.h"
@@ -179,7 +184,45 @@ class Refiner {
 
   // --- ForceInsert (Figure 3.5) + UpdateLocation (3.6) + PropagateLocation (3.9)
   absl::Status ForceInsertOmega(PointId p, TetId hint);
-  absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t);
+  absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd = kCdSegment);
+
+  // --- Collars (stage (d): thesis §3.1.2, Figures 3.5, 3.7–3.9) ---------------
+ public:
+  // The exact distance from x to feature f (normalised coordinates), +inf if
+  // point p lies on f (combinatorially) or f is Ω.
+  double FeatureDistance(FeatureId f, PointId p, const Vec3& x) const;
+  // Does feature f contain point p (an input point or a segment point)?
+  bool FeatureContains(FeatureId f, PointId p) const;
+  const CollarIndex& collars() const { return collars_; }
+  PointId CollarCentre(uint32_t i) const { return collar_centre_[i]; }
+  // Features of the complex for oracles: 0 point, 1 segment, 2 facet.
+  uint32_t NumFeatures() const { return features_.size(); }
+  int FeatureDim(FeatureId f) const { return features_.Dim(f); }
+ private:
+  // Figure 3.7 for crease point p, just inserted into M_Ω as vertex nv.
+  absl::Status CreateCollar(PointId p, VertexId nv);
+  // Figure 3.9's suppression: p is strictly inside a collar ball and is not a
+  // crease point (crease vertices and points of crease segments are always
+  // resolved). Monotone (collars only grow): cached once true.
+  bool Suppressed(PointId p);
+  // An element with a vertex or its centroid strictly inside a collar ball is
+  // left to RipStitchCollar (stage (f)) by the end-of-run checks.
+  bool InsideCollars(std::span<const PointId> verts) const;
+  // A triangle of a facet mesh with a vertex or its centroid strictly inside
+  // a collar: it need not conform to non-crease segments there.
+  bool TriangleInCollars(const FacetMesh& m, TriId2 t) const {
+    if (!options_.collars || collars_.size() == 0) return false;
+    const std::array<PointId, 3> v{m.PointOf(m.dt().TriVertex(t, 0)), m.PointOf(m.dt().TriVertex(t, 1)),
+                                   m.PointOf(m.dt().TriVertex(t, 2))};
+    return InsideCollars(v);
+  }
+  // A piece of a non-crease segment whose midpoint is strictly inside a collar.
+  bool PieceInCollars(BallId piece) const {
+    if (!options_.collars || collars_.size() == 0) return false;
+    const PointId a = balls_.Vertex(piece, 0), b = balls_.Vertex(piece, 1);
+    if (points_.IsCrease(a) && points_.IsCrease(b)) return false;
+    return collars_.StrictlyInside(0.5 * (points_.Xyz(a) + points_.Xyz(b)));
+  }
   absl::Status ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hint);
 
   // --- BLG helpers -------------------------------------------------------------
@@ -289,6 +332,13 @@ class Refiner {
   // Balls that got a first, non-native encroacher (PartiallyEncroached).
   std::vector<BallId> partial_;
   std::vector<double> size_target_;  // per M_Ω vertex: max R_v from max_volume (+inf: none)
+  // Collars (stage (d)).
+  const plc::FeatureComplex* complex_ = nullptr;
+  CollarIndex collars_;
+  std::vector<PointId> collar_centre_;          // per collar
+  std::vector<uint8_t> has_collar_;             // per point
+  std::vector<uint8_t> suppressed_;             // per point: 1 once strictly inside a collar
+  std::vector<std::vector<uint32_t>> point_segments_;  // per complex point: segments ending there
   RefineStats stats_;
   uint64_t budget_ = 0;
   // The cell size IsLive computed for the event Destroy gets next.
@@ -379,8 +429,14 @@ absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const 
   budget_ = options_.max_vertices != 0 ? options_.max_vertices
                                        : std::max<uint64_t>(1'000'000, 1000ull * num_input_);
   // Global ids = SoS priorities: inputs first (in input order), then corners.
+  complex_ = &complex;
   for (uint32_t i = 0; i < num_input_; ++i) {
-    points_.Add(normalised[i], features_.OfPoint(i), kCdInputVertex);
+    points_.Add(normalised[i], features_.OfPoint(i), kCdInputVertex, options_.collars && complex.points[i].crease);
+  }
+  point_segments_.assign(num_input_, {});
+  for (uint32_t s = 0; s < complex.segments.size(); ++s) {
+    point_segments_[complex.segments[s].a].push_back(s);
+    point_segments_[complex.segments[s].b].push_back(s);
   }
   std::array<PointId, 8> corners;
   for (int i = 0; i < 8; ++i) corners[i] = points_.Add(omega_.Corner(i), FeatureTable::Omega(), kCdSpace);
@@ -601,6 +657,7 @@ void Refiner::LinkPieceToFacet(BallId b, uint32_t f, TriId2 hint) {
 }
 
 void Refiner::LinkVertexBallToFacet(BallId b, uint32_t f, TriId2 hint) {
+  if (Suppressed(balls_.VertexPoint(b))) return;
   const delaunay::Delaunay2& dt = facets_[f].dt();
   const VertexId2 cell = dt.NearestVertex(Uv(f, balls_.VertexPoint(b)), hint);
   LinkFacts facts;
@@ -649,6 +706,7 @@ void Refiner::LinkBallToOmega(BallId b, VertexId start) {
 }
 
 void Refiner::LinkVertexBallToOmega(BallId b, VertexId start) {
+  if (Suppressed(balls_.VertexPoint(b))) return;
   const delaunay::Delaunay3& dt = omega_.dt();
   const VertexId cell = dt.NearestVertex(balls_.Center(b), dt.VertexTet(start));
   LinkFacts facts;
@@ -884,7 +942,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
       if (!(balls_.CdOf(b) < kCdFacet) || !balls_.IsAlive(b)) continue;
       if (balls_.IsVertexBall(b)) {
         const PointId p = balls_.VertexPoint(b);
-        if (points_.InMesh(p, mesh)) continue;
+        if (points_.InMesh(p, mesh) || Suppressed(p)) continue;
         const Vec2 q = Uv(f, p);
         const double d2 = (q.x - c.x) * (q.x - c.x) + (q.y - c.y) * (q.y - c.y);
         // Destroying a triangle's disk, any unresolved lower point strictly
@@ -906,8 +964,11 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
         // splitting it while the piece is not an edge of M_F refines the
         // wrong side of the segment against the neighbouring facet's points
         // (measured: box_internal_facet ran to the vertex budget).
+        // Inside the collars a facet need not conform to a non-crease
+        // segment (its points there are suppressed, Figure 3.9): no straddle
+        // yield (measured: crease_pair_30 split such a piece without end).
         const bool straddles =
-            tri.valid() && m.dt().IsAlive(tri) &&
+            tri.valid() && m.dt().IsAlive(tri) && !PieceInCollars(b) && !TriangleInCollars(m, tri) &&
             TriangleMeetsSegment(m.dt().Point(m.dt().TriVertex(tri, 0)), m.dt().Point(m.dt().TriVertex(tri, 1)),
                                  m.dt().Point(m.dt().TriVertex(tri, 2)), ua, ub);
         if (straddles) ++stats_.straddle_yields;
@@ -995,7 +1056,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
       if (!(balls_.CdOf(b) < cd_ball)) continue;
       if (balls_.IsVertexBall(b)) {
         const PointId p = balls_.VertexPoint(b);
-        if (points_.InMesh(p, kOmegaMesh)) continue;
+        if (points_.InMesh(p, kOmegaMesh) || Suppressed(p)) continue;
         const double d2 = geom::Dist2(balls_.Center(b), c);
         if (d2 > theta_r2) continue;
         // Line 6: lowest CD, then nearest to c, then lowest id (determinism).
@@ -1092,7 +1153,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
         }
         continue;
       }
-      if (points_.InMesh(balls_.VertexPoint(b), kOmegaMesh)) continue;
+      if (points_.InMesh(balls_.VertexPoint(b), kOmegaMesh) || Suppressed(balls_.VertexPoint(b))) continue;
       const Vec3& q = balls_.Center(b);
       const int cmp = geom::CompareDistance(q, pu, pos);  // > 0: u is farther
       const bool to_new = cmp > 0 || (cmp == 0 && p.value() < omega_.PointOf(u).value());
@@ -1112,15 +1173,17 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   }
   // Figure 3.5's loop over 𝒱': DecreaseSize / enqueue Skinny and Unresolved.
   for (size_t i = 0; i < changed.size(); ++i) RefreshEvents(changed[i], &sizes[i]);
+  // Figure 3.5 lines 5–7: a crease point from a lower feature gets its collar.
+  if (options_.collars && points_.IsCrease(p) && points_.CdOf(p).dim < 3) return CreateCollar(p, nv);
   return absl::OkStatus();
 }
 
-absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t) {
+absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd) {
   SegmentMesh& m = segs_[seg];
   const uint32_t w = m.Next(u);
   const FeatureId f = features_.OfSegment(seg);
   const MeshId mesh = SegMesh(seg);
-  const PointId p = points_.Add(m.PointAt(t), f, kCdSegment);
+  const PointId p = points_.Add(m.PointAt(t), f, cd, options_.collars && complex_->segments[seg].crease);
   const uint32_t mid = m.Split(u, t, p);
   points_.SetVertex(p, mesh, mid);
   ++stats_.segment_vertices;
@@ -1141,7 +1204,7 @@ absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t) {
   blg_.RemoveObjectLinks(LocationObject::Ball(old_piece), kOmegaMesh, &old_cells);
   const BallId left = balls_.AddPieceBall(m.PointOf(u), p, points_.Xyz(m.PointOf(u)), points_.Xyz(p), f, mesh);
   const BallId right = balls_.AddPieceBall(p, m.PointOf(w), points_.Xyz(p), points_.Xyz(m.PointOf(w)), f, mesh);
-  const BallId vb = balls_.AddVertexBall(p, points_.Xyz(p), f, mesh, kCdSegment);
+  const BallId vb = balls_.AddVertexBall(p, points_.Xyz(p), f, mesh, cd);
   m.PieceBall(u) = left;
   m.PieceBall(mid) = right;
   m.VertexBall(mid) = vb;
@@ -1233,7 +1296,7 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
         continue;
       }
       const PointId q = balls_.VertexPoint(b);
-      if (points_.InMesh(q, mesh)) continue;
+      if (points_.InMesh(q, mesh) || Suppressed(q)) continue;
       const int cmp = geom::CompareDistance(Uv(f, q), pu, uv);  // > 0: u is farther
       const bool to_new = cmp > 0 || (cmp == 0 && p.value() < m.PointOf(u).value());
       LinkFacts facts;
@@ -1268,6 +1331,171 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
   return absl::OkStatus();
 }
 
+// ---------------------------------------------------------------- collars
+
+bool Refiner::FeatureContains(FeatureId f, PointId p) const {
+  const int d = features_.Dim(f);
+  if (d == 3) return true;
+  const uint32_t idx = features_.Index(f);
+  const FeatureId parent = points_.Parent(p);
+  const int pd = features_.Dim(parent);
+  if (pd == 0) {
+    const uint32_t i = features_.Index(parent);
+    if (d == 0) return idx == i;
+    if (d == 1) return complex_->segments[idx].a == i || complex_->segments[idx].b == i;
+    const auto& fs = point_facets_[i];
+    return std::find(fs.begin(), fs.end(), idx) != fs.end();
+  }
+  if (pd == 1) {
+    const uint32_t sg = features_.Index(parent);
+    if (d == 1) return idx == sg;
+    if (d == 2) {
+      const auto& fs = seg_facets_[sg];
+      return std::find(fs.begin(), fs.end(), idx) != fs.end();
+    }
+    return false;
+  }
+  if (pd == 2) return d == 2 && features_.Index(parent) == idx;
+  return false;
+}
+
+double Refiner::FeatureDistance(FeatureId f, PointId p, const Vec3& x) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const int d = features_.Dim(f);
+  if (d == 3 || FeatureContains(f, p)) return kInf;
+  const uint32_t idx = features_.Index(f);
+  if (d == 0) return geom::Dist(x, points_.Xyz(PointId(idx)));
+  if (d == 1) {
+    const plc::FeatureSegment& sg = complex_->segments[idx];
+    return plc::PointSegmentDistance(x, points_.Xyz(PointId(sg.a)), points_.Xyz(PointId(sg.b)));
+  }
+  // A facet: its plane if x projects into the facet, else its nearest segment
+  // (every polygon edge is a segment of the complex).
+  const plc::FacetFrame& fr = frames_[idx];
+  if (facets_[idx].region().Locate(fr.ToPlane(x)) != FacetRegion::Where::kOutside) {
+    return std::abs(geom::Dot(x - fr.origin, fr.normal));
+  }
+  double best = kInf;
+  for (uint32_t sg : complex_->facets[idx].segments) {
+    const plc::FeatureSegment& fs = complex_->segments[sg];
+    best = std::min(best, plc::PointSegmentDistance(x, points_.Xyz(PointId(fs.a)), points_.Xyz(PointId(fs.b))));
+  }
+  return best;
+}
+
+bool Refiner::Suppressed(PointId p) {
+  if (!options_.collars || collars_.size() == 0 || points_.IsCrease(p)) return false;
+  if (p.value() < suppressed_.size() && suppressed_[p.value()]) return true;
+  if (!collars_.StrictlyInside(points_.Xyz(p))) return false;
+  if (suppressed_.size() <= p.value()) suppressed_.resize(p.value() + 1024, 0);
+  suppressed_[p.value()] = 1;
+  ++stats_.suppressed_points;
+  return true;
+}
+
+bool Refiner::InsideCollars(std::span<const PointId> verts) const {
+  if (collars_.size() == 0) return false;
+  Vec3 c{0, 0, 0};
+  for (PointId v : verts) {
+    const Vec3& x = points_.Xyz(v);
+    if (collars_.StrictlyInside(x)) return true;
+    c = c + x;
+  }
+  return collars_.StrictlyInside(c * (1.0 / static_cast<double>(verts.size())));
+}
+
+absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
+  if (has_collar_.size() <= p.value()) has_collar_.resize(p.value() + 1024, 0);
+  if (has_collar_[p.value()]) return absl::OkStatus();  // one collar per point (guide §7)
+  has_collar_[p.value()] = 1;
+  const delaunay::Delaunay3& dt = omega_.dt();
+  const Vec3 pos = points_.Xyz(p);
+  // Figure 3.8 over M_Ω (guide: only M_Ω sees every feature's balls). A
+  // cell's features: those of its linked ConfBalls (pieces, triangles,
+  // unresolved points) and its own vertex's feature (resolved points have no
+  // links left in M_Ω).
+  std::vector<BallId> cell_balls;
+  auto cell_features = [&](VertexId u, std::vector<uint32_t>* out) {
+    cell_balls.clear();
+    blg_.BallsOf(kOmegaMesh, u.value(), &cell_balls);
+    for (BallId b : cell_balls) out->push_back(balls_.Feature(b).value());
+    const FeatureId own = points_.Parent(omega_.PointOf(u));
+    if (features_.Dim(own) < 3) out->push_back(own.value());
+  };
+  auto feature_distance = [&](uint32_t f, const Vec3& x) { return FeatureDistance(FeatureId(f), p, x); };
+  const CollarSizeResult g = FastCollarSize(dt, pos, nv, cell_features, feature_distance);
+  stats_.collar_cells_explored += g.cells_explored;
+  stats_.max_collar_cells = std::max<uint64_t>(stats_.max_collar_cells, g.cells_explored);
+  if (!std::isfinite(g.radius) || !(g.radius > 0)) return absl::OkStatus();
+  const double rho = g.radius;
+  collars_.Add(CollarBall{pos, rho});
+  collar_centre_.push_back(p);
+  ++stats_.collars;
+  const bool vertex_collar = features_.Dim(points_.Parent(p)) == 0;
+  if (vertex_collar) ++stats_.vertex_collars;
+
+  // Figure 3.9: unresolved points now strictly inside the collar are dropped
+  // (their links go; Suppressed() keeps them out from now on). M_Ω first.
+  std::vector<VertexId> cells;
+  CellsMeetingBall(pos, rho, nv, &cells);
+  std::vector<LocationObject> objs;
+  for (VertexId u : cells) {
+    objs.clear();
+    blg_.ObjectsOf(kOmegaMesh, u.value(), &objs);
+    bool changed = false;
+    for (const LocationObject& o : objs) {
+      if (o.kind != ObjectKind::kBall || !balls_.IsVertexBall(BallId(o.id))) continue;
+      const PointId q = balls_.VertexPoint(BallId(o.id));
+      if (points_.InMesh(q, kOmegaMesh) || !Suppressed(q)) continue;
+      blg_.RemoveLink(kOmegaMesh, u.value(), o);
+      changed = true;
+    }
+    if (changed) RefreshEvents(u);
+  }
+  // The facets through p: the collar's disk in each facet mesh.
+  std::vector<VertexId2> cells2;
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    if (!FeatureContains(features_.OfFacet(f), p)) continue;
+    const Vec2 uv = Uv(f, p);
+    const VertexId2 w = facets_[f].dt().NearestVertex(uv);
+    CellsMeetingDisk(f, uv, rho, w, &cells2);
+    const std::vector<VertexId2> mine = cells2;
+    for (VertexId2 u : mine) {
+      objs.clear();
+      blg_.ObjectsOf(FacetMeshId(f), u.value(), &objs);
+      bool changed = false;
+      for (const LocationObject& o : objs) {
+        if (o.kind != ObjectKind::kBall || !balls_.IsVertexBall(BallId(o.id))) continue;
+        const PointId q = balls_.VertexPoint(BallId(o.id));
+        if (points_.InMesh(q, FacetMeshId(f)) || !Suppressed(q)) continue;
+        blg_.RemoveLink(FacetMeshId(f), u.value(), o);
+        changed = true;
+      }
+      if (changed) RefreshFacetEvents(f, u);
+    }
+  }
+  // Figure 3.7 line 10: every segment at a vertex collar gets the (1,2) point
+  // where the collar sphere crosses it, inserted into M_s (the Unresolved₁
+  // event destroyed at once: M_s has no other work on it).
+  if (vertex_collar) {
+    const uint32_t i = features_.Index(points_.Parent(p));
+    for (uint32_t sg : point_segments_[i]) {
+      SegmentMesh& m = segs_[sg];
+      const double len = geom::Dist(points_.Xyz(m.PointOf(0)), points_.Xyz(m.PointOf(1)));
+      if (!(rho < len)) continue;
+      const bool at_a = m.PointOf(0) == p;
+      const double t = at_a ? rho / len : 1 - rho / len;
+      uint32_t u = 0;
+      while (m.Next(u) != SegmentMesh::kNil && m.T(m.Next(u)) <= t) u = m.Next(u);
+      if (m.Next(u) == SegmentMesh::kNil || m.T(u) == t || !(t > m.T(u) && t < m.T(m.Next(u)))) continue;
+      ++stats_.points_12;
+      absl::Status st = ForceInsertSegment(sg, u, t, Cd{1, 2});
+      if (!st.ok()) return st;
+    }
+  }
+  return absl::OkStatus();
+}
+
 // ---------------------------------------------------------------- checks
 
 absl::Status Refiner::CheckInvariants(bool final) {
@@ -1282,7 +1510,7 @@ absl::Status Refiner::CheckInvariants(bool final) {
   for (uint32_t i = 0; i < points_.size(); ++i) {
     const PointId p(i);
     const BallId b = VertexBallOf(p);
-    if (!b.valid() || points_.InMesh(p, kOmegaMesh)) continue;
+    if (!b.valid() || points_.InMesh(p, kOmegaMesh) || (i < suppressed_.size() && suppressed_[i])) continue;
     if (final) return absl::InternalError(absl::StrCat("SVRC invariant: point ", i, " not in M_Ω"));
     std::vector<uint32_t> cells;
     blg_.CellsOf(LocationObject::Ball(b), kOmegaMesh, &cells);
@@ -1591,6 +1819,7 @@ bool Refiner::EnqueueMissing() {
     SegmentMesh& m = segs_[sg];
     for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
       const PointId a = m.PointOf(v), b = m.PointOf(m.Next(v));
+      if (options_.collars && InsideCollars(std::array<PointId, 2>{a, b})) continue;
       bool missing = !OmegaHasEdge(a, b);
       for (uint32_t fc : seg_facets_[sg]) missing = missing || !FacetHasEdge(fc, a, b);
       if (missing) {
@@ -1605,6 +1834,10 @@ bool Refiner::EnqueueMissing() {
     for (TriId2 t : dt.Triangles()) {
       const BallId b = facets_[f].TriBall(t);
       if (!b.valid()) continue;
+      if (options_.collars &&
+          InsideCollars(std::array<PointId, 3>{balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2)})) {
+        continue;
+      }
       if (!OmegaHasFace(balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2))) {
         ++stats_.tied_balls;
         EnqueueEncroached(b);
@@ -1624,6 +1857,7 @@ absl::Status Refiner::VerifyConformity() const {
     for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
       std::array<uint32_t, 2> e{m.PointOf(v).value(), m.PointOf(m.Next(v)).value()};
       std::sort(e.begin(), e.end());
+      if (options_.collars && InsideCollars(std::array<PointId, 2>{PointId(e[0]), PointId(e[1])})) continue;
       if (!std::binary_search(edges.begin(), edges.end(), e)) {
         return absl::InternalError(absl::StrCat("SVRC: piece (", e[0], ", ", e[1], ") of segment ", sg,
                                                 " is not an edge of M_Ω"));
@@ -1634,6 +1868,9 @@ absl::Status Refiner::VerifyConformity() const {
     for (const auto& tri : facets_[f].InFacetTriangles()) {
       std::array<uint32_t, 3> k{tri[0].value(), tri[1].value(), tri[2].value()};
       std::sort(k.begin(), k.end());
+      if (options_.collars && InsideCollars(std::array<PointId, 3>{PointId(k[0]), PointId(k[1]), PointId(k[2])})) {
+        continue;
+      }
       if (!std::binary_search(faces.begin(), faces.end(), k)) {
         return absl::InternalError(absl::StrCat("SVRC: in-facet triangle (", k[0], ", ", k[1], ", ", k[2],
                                                 ") of facet ", f, " is not a face of M_Ω"));
@@ -1646,6 +1883,11 @@ absl::Status Refiner::VerifyConformity() const {
 PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   const delaunay::Delaunay3& dt = omega_.dt();
   PointSetRefinement out;
+  for (uint32_t i = 0; i < collars_.size(); ++i) {
+    const FeatureId f = points_.Parent(collar_centre_[i]);
+    out.collars.push_back({collar_centre_[i].value(), features_.Dim(f), features_.Index(f), collars_.ball(i).center,
+                           collars_.ball(i).radius});
+  }
   out.num_input = num_input_;
   out.positions.resize(points_.size());
   out.normalised_positions.resize(points_.size());
@@ -1797,7 +2039,8 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   if (complex.points.empty()) return absl::InvalidArgumentError("SVRC: the PLC has no points");
   // Creases (Definitions 4–5) need collars (issue #6): refuse them up front,
   // naming the first, rather than refine towards the budget.
-  for (uint32_t s = 0; s < complex.segments.size() && !options.attempt_creases; ++s) {
+  const bool creases_ok = options.attempt_creases || options.collars;
+  for (uint32_t s = 0; s < complex.segments.size() && !creases_ok; ++s) {
     const plc::FeatureSegment& fs = complex.segments[s];
     if (fs.crease) {
       return absl::FailedPreconditionError(absl::StrCat(
@@ -1805,7 +2048,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
           " degrees < 90; creases need collars, not implemented yet"));
     }
   }
-  for (uint32_t i = 0; i < complex.points.size() && !options.attempt_creases; ++i) {
+  for (uint32_t i = 0; i < complex.points.size() && !creases_ok; ++i) {
     if (complex.points[i].crease) {
       const Vec3& p = complex.points[i].p;
       return absl::FailedPreconditionError(absl::StrCat("SVRC: crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,

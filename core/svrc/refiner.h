@@ -45,6 +45,14 @@ struct RefineOptions {
   // RefinePlc: refine through creases instead of refusing them (no collars:
   // may run to the budget; the caller bounds it). Default: refuse.
   bool attempt_creases = false;
+  // RefinePlc: the crease machinery of thesis §3.1.2 (issue #6, stage (d)):
+  // a collar ball B(p, g(p)/3) (FastCollarSize, Figure 3.8) when a crease
+  // point enters M_Ω, (1,2) points where a vertex collar's sphere meets the
+  // segments at that vertex, Unresolved work and warps inside the collars
+  // dropped except on crease segments (Figure 3.9), and the end-of-run
+  // conformity checks limited to elements outside the collars. Implies
+  // attempt_creases.
+  bool collars = false;
   // Called at every poll: vertices in all meshes, pending events, radius of
   // the event about to be destroyed (the largest work radius). May be null.
   std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;
@@ -69,6 +77,13 @@ struct RefineStats {
   uint64_t tied_balls = 0;
   uint64_t straddle_yields = 0;
   uint64_t size_rounds = 0;
+  uint64_t collars = 0;            // collar balls created (stage (d))
+  uint64_t vertex_collars = 0;     // of those, centred on an input vertex
+  uint64_t collar_cells_explored = 0;  // FastCollarSize cells popped, summed (Lemma 35)
+  uint64_t max_collar_cells = 0;
+  uint64_t suppressed_points = 0;  // unresolved points dropped inside collars (Figure 3.9)
+  uint64_t points_12 = 0;          // (1,2) points: vertex-collar spheres ∩ segments
+  uint64_t collar_exempt = 0;      // pieces/triangles inside collars left to RipStitchCollar
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
@@ -116,6 +131,16 @@ struct PointSetRefinement {
   // Per facet of the complex: its in-facet triangles (position indices), each
   // a face of `tets` (checked before returning).
   std::vector<std::vector<std::array<uint32_t, 3>>> facet_triangles;
+  // options.collars: the collar balls (normalised coordinates), in creation
+  // order, each centred on a crease point (a position index).
+  struct Collar {
+    uint32_t centre = 0;
+    int feature_dim = 0;      // the centre's feature: 0 an input point, 1 a crease segment
+    uint32_t feature = 0;     // its index in the complex's points or segments
+    geom::Vec3 center;
+    double radius = 0;
+  };
+  std::vector<Collar> collars;
   RefineStats stats;
 };
 
