@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -16,7 +18,10 @@
 #include "core/plc/features.h"
 #include "core/plc/intersect.h"
 #include "core/svrc/balls.h"
+#include "core/svrc/collar_arcs.h"
 #include "core/svrc/collar_index.h"
+#include "core/svrc/collar_surface.h"
+#include "core/svrc/rip_stitch.h"
 #include "core/svrc/collar_size.h"
 #include "core/svrc/containment.h"
 #include "core/svrc/facet_mesh.h"
@@ -123,7 +128,7 @@ class Refiner {
   // else insert the centre.
   absl::Status DestroyOmega(VertexId v);
   // Figure 3.4 for the gap ball B(c, r) of M_Ω, c in the cell of v.
-  absl::Status DestroyOmegaAt(const Vec3& c, double r, TetId hint, VertexId v);
+  absl::Status DestroyOmegaAt(const Vec3& c, double r, TetId hint, VertexId v, Cd cd_ball = kCdSpace);
  public:
   // Near-flat tets of M_Ω (6|V| ≤ 10^−6·ℓ³, ℓ the longest edge), which the
   // flip pass cannot always remove (four nearly cocircular coplanar points
@@ -144,7 +149,8 @@ class Refiner {
   // yield from M_Ω). `hint`: a triangle of M_F in conflict with c.
   // `tri`: the triangle whose ball is being destroyed (kNone for a cell's
   // gap ball); a piece of F crossing it is yielded to.
-  absl::Status DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, TriId2 tri = TriId2());
+  absl::Status DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, TriId2 tri = TriId2(), Cd cd_ball = kCdFacet,
+                            bool jitter = true);
   // Destroys a conforming ball of a lower feature (a yield target or an
   // Encroached event): a segment piece or a facet triangle.
   absl::Status DestroyBall(BallId b);
@@ -199,6 +205,18 @@ class Refiner {
   uint32_t NumFeatures() const { return features_.size(); }
   int FeatureDim(FeatureId f) const { return features_.Dim(f); }
  private:
+ public:
+  // COLLAR events (thesis §3.1.2, Figure 3.10's RepBall trap), in rounds at
+  // the end of the queues (Figure 3.11 pops them last): the restricted
+  // Delaunay of the collar surface in M_Ω (CollarRepairs) and of each facet's
+  // arcs (ArcRepairs); every repair point is destroyed as a gap ball of CD
+  // (3,d) / (2,d). Returns whether anything was inserted.
+  absl::StatusOr<bool> CollarRound() { return CollarRoundImpl(); }
+  // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
+  absl::Status Stitch() { return StitchImpl(); }
+ private:
+  absl::StatusOr<bool> CollarRoundImpl();
+  absl::Status StitchImpl();
   // Figure 3.7 for crease point p, just inserted into M_Ω as vertex nv.
   absl::Status CreateCollar(PointId p, VertexId nv);
   // Figure 3.9's suppression: p is strictly inside a collar ball and is not a
@@ -339,6 +357,13 @@ class Refiner {
   std::vector<uint8_t> has_collar_;             // per point
   std::vector<uint8_t> suppressed_;             // per point: 1 once strictly inside a collar
   std::vector<std::vector<uint32_t>> point_segments_;  // per complex point: segments ending there
+  bool stitched_done_ = false;
+  std::vector<std::array<uint32_t, 4>> stitched_;     // final tets (point ids) after RipStitchCollar
+ public:
+  StitchResult stitch_report_;
+  CollarSurfaceReport surface_report_;
+  uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0;
+ private:
   RefineStats stats_;
   uint64_t budget_ = 0;
   // The cell size IsLive computed for the event Destroy gets next.
@@ -919,7 +944,7 @@ absl::Status Refiner::DestroyBall(BallId b) {
   return DestroyFacet(f, c, r, t, t);
 }
 
-absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, TriId2 tri) {
+absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, TriId2 tri, Cd cd_ball, bool jitter) {
   // Figure 3.4 in M_F. 𝒱: cells meeting B (from the nearest vertex to c);
   // 𝓑: balls linked to them — 0-balls of F's points and segment points
   // (warp targets, CD < (2,3)) and piece balls of F's segments (yields).
@@ -939,7 +964,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
     double warp_d2 = 0;
     GatherBalls(mesh, bfs2_, &gathered_);
     for (BallId b : gathered_) {
-      if (!(balls_.CdOf(b) < kCdFacet) || !balls_.IsAlive(b)) continue;
+      if (!(balls_.CdOf(b) < cd_ball) || !balls_.IsAlive(b)) continue;
       if (balls_.IsVertexBall(b)) {
         const PointId p = balls_.VertexPoint(b);
         if (points_.InMesh(p, mesh) || Suppressed(p)) continue;
@@ -991,11 +1016,11 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
         return absl::InternalError(absl::StrCat("SVRC: facet ", f, " gap ball centre (", c.x, ", ", c.y, ") r=", r, " outside its square Ω_F [", m.SquareLo().x, ",", m.SquareHi().x, "]x[", m.SquareLo().y, ",", m.SquareHi().y, "]"));
       }
       const uint64_t id = points_.size();
-      Vec2 cj{c.x + kJitter * r * Jitter(id, 1), c.y + kJitter * r * Jitter(id, 2)};
+      Vec2 cj = jitter ? Vec2{c.x + kJitter * r * Jitter(id, 1), c.y + kJitter * r * Jitter(id, 2)} : c;
       if (!(cj.x >= m.SquareLo().x && cj.x <= m.SquareHi().x && cj.y >= m.SquareLo().y && cj.y <= m.SquareHi().y)) {
         cj = c;  // a corner on ∂Ω_F stays on it
       }
-      const PointId p = points_.Add(frames_[f].ToSpace(cj), features_.OfFacet(f), kCdFacet);
+      const PointId p = points_.Add(frames_[f].ToSpace(cj), features_.OfFacet(f), cd_ball);
       return ForceInsertFacet(f, p, cj, hint);
     }
     ++stats_.yields;
@@ -1027,11 +1052,10 @@ absl::Status Refiner::DestroyOmega(VertexId v) {
   return DestroyOmegaAt(s.corner, s.outradius, s.hint, v);
 }
 
-absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, VertexId v) {
+absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, VertexId v, Cd cd_ball) {
   struct {
     TetId hint;
   } s{cell_hint};
-  const Cd cd_ball = kCdSpace;
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy yielded without end");
@@ -1040,7 +1064,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     }
     if (blg_.NumLinks() == 0) {
       // 𝓑 = ∅: nothing to warp or yield to.
-      return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), kCdSpace), s.hint);
+      return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), cd_ball), s.hint);
     }
     // Line 2: 𝒱 = cells meeting B (v is nearest to c: c is its corner).
     CellsMeetingBall(c, r, v, &bfs_);
@@ -1089,7 +1113,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
         ++stats_.phantom_corners;
         return absl::OkStatus();
       }
-      return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), kCdSpace), s.hint);
+      return ForceInsertOmega(points_.Add(c, FeatureTable::Omega(), cd_ball), s.hint);
     }
     // Lines 13–14: destroy the lower ball first (one insertion into M_s), then
     // start over: the new segment point may now be a warp target. M_Ω did not
@@ -1321,7 +1345,7 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
   // points of Ω_F outside F stay scaffolding of M_F (Figure 3.6, "kept if
   // dim(T ∩ F) = dim T").
   if (steiner && m.region().Locate(uv) != FacetRegion::Where::kOutside) {
-    const BallId vb = balls_.AddVertexBall(p, points_.Xyz(p), features_.OfFacet(f), mesh, kCdFacet);
+    const BallId vb = balls_.AddVertexBall(p, points_.Xyz(p), features_.OfFacet(f), mesh, points_.CdOf(p));
     SetVertexBall(p, vb);
     LinkVertexBallToOmega(vb, start);
   }
@@ -1385,6 +1409,7 @@ double Refiner::FeatureDistance(FeatureId f, PointId p, const Vec3& x) const {
 
 bool Refiner::Suppressed(PointId p) {
   if (!options_.collars || collars_.size() == 0 || points_.IsCrease(p)) return false;
+  if (points_.CdOf(p).collar < 3) return false;  // constructed on S: resolved (Definition 37)
   if (p.value() < suppressed_.size() && suppressed_[p.value()]) return true;
   if (!collars_.StrictlyInside(points_.Xyz(p))) return false;
   if (suppressed_.size() <= p.value()) suppressed_.resize(p.value() + 1024, 0);
@@ -1493,6 +1518,120 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
       if (!st.ok()) return st;
     }
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<bool> Refiner::CollarRoundImpl() {
+  if (collars_.size() == 0) return false;
+  const CollarDescription desc = BuildCollarDescription(collars_.balls());
+  CollarSurfaceOptions copt;
+  copt.sigma = options_.max_rep_angle;
+  surface_report_ = CollarSurfaceReport();
+  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_);
+  // Largest RepBall first (Figure 3.11's buckets), ties by position.
+  std::stable_sort(reps.begin(), reps.end(), [](const CollarRepair& a, const CollarRepair& b) { return a.radius > b.radius; });
+  bool any = false;
+  const delaunay::Delaunay3& dt = omega_.dt();
+  for (const CollarRepair& r : reps) {
+    const VertexId v = dt.NearestVertex(r.x);
+    if (dt.Point(v) == r.x) continue;
+    // The RepBall is empty by construction (Definition 38); an earlier repair
+    // of this round may have destroyed it.
+    if (geom::Dist(dt.Point(v), r.x) < r.radius * (1 - 1e-9)) continue;
+    absl::Status st = DestroyOmegaAt(r.x, r.radius, dt.VertexTet(v), v, Cd{3, static_cast<uint8_t>(r.collar_dim)});
+    if (!st.ok()) return st;
+    ++collar_repairs_;
+    any = true;
+  }
+  // The 2D collar systems of the facets a collar ball reaches.
+  std::vector<CollarBall> near;
+  std::vector<uint32_t> cand;
+  for (uint32_t f = 0; f < facets_.size(); ++f) {
+    FacetMesh& m = facets_[f];
+    const plc::FacetFrame& fr = frames_[f];
+    near.clear();
+    for (uint32_t i = 0; i < collars_.size(); ++i) {
+      const CollarBall& b = collars_.ball(i);
+      if (std::abs(geom::Dot(b.center - fr.origin, fr.normal)) >= b.radius) continue;
+      const Vec2 uv = fr.ToPlane(b.center);
+      if (uv.x + b.radius < m.SquareLo().x || uv.x - b.radius > m.SquareHi().x || uv.y + b.radius < m.SquareLo().y ||
+          uv.y - b.radius > m.SquareHi().y) {
+        continue;
+      }
+      near.push_back(b);
+    }
+    if (near.empty()) continue;
+    const FacetCollarSystem sys = FacetCollars(fr, near);
+    ArcOptions aopt;
+    if (std::getenv("SVRC_ARC_LOOSE") != nullptr) {
+      aopt.require_on_arc = false;
+      aopt.eps = 0;
+    }
+    std::vector<ArcRepair> ar = ArcRepairs(m.dt(), sys, options_.max_rep_angle, nullptr, aopt);
+    std::stable_sort(ar.begin(), ar.end(), [](const ArcRepair& a, const ArcRepair& b) {
+      return a.collar_dim < b.collar_dim || (a.collar_dim == b.collar_dim && a.radius > b.radius);
+    });
+    for (const ArcRepair& r : ar) {
+      if (!(r.x.x >= m.SquareLo().x && r.x.x <= m.SquareHi().x && r.x.y >= m.SquareLo().y && r.x.y <= m.SquareHi().y)) continue;
+      const VertexId2 w = m.dt().NearestVertex(r.x);
+      const Vec2 pw = m.dt().Point(w);
+      if (pw.x == r.x.x && pw.y == r.x.y) continue;
+      const double d = std::hypot(pw.x - r.x.x, pw.y - r.x.y);
+      if (r.collar_dim == 2 && d < r.radius * (1 - 1e-9)) continue;  // destroyed earlier this round
+      const TriId2 hint = m.dt().Locate(r.x, m.dt().VertexTri(w));
+      absl::Status st = DestroyFacet(f, r.x, std::max(d, r.radius), hint, TriId2(), Cd{2, static_cast<uint8_t>(r.collar_dim)},
+                                     /*jitter=*/false);
+      if (!st.ok()) return st;
+      ++arc_repairs_;
+      any = true;
+    }
+  }
+  if (any) ++collar_rounds_;
+  return any;
+}
+
+absl::Status Refiner::StitchImpl() {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  std::vector<StitchBall> balls(collars_.size());
+  std::vector<uint32_t> ball_of_point(points_.size(), CollarIndex::kNone);
+  for (uint32_t i = 0; i < collars_.size(); ++i) {
+    const PointId p = collar_centre_[i];
+    balls[i].ball = collars_.ball(i);
+    balls[i].centre = VertexId(points_.VertexIn(p, kOmegaMesh));
+    ball_of_point[p.value()] = i;
+  }
+  // Crease edges: consecutive collared points along each crease segment.
+  std::vector<std::pair<uint32_t, uint32_t>> edges;
+  for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
+    if (!complex_->segments[sg].crease) continue;
+    const SegmentMesh& m = segs_[sg];
+    uint32_t prev = CollarIndex::kNone;
+    for (uint32_t v = 0; v != SegmentMesh::kNil; v = m.Next(v)) {
+      const uint32_t b = ball_of_point[m.PointOf(v).value()];
+      if (b == CollarIndex::kNone) {
+        prev = CollarIndex::kNone;
+        continue;
+      }
+      if (prev != CollarIndex::kNone) edges.emplace_back(std::min(prev, b), std::max(prev, b));
+      prev = b;
+    }
+  }
+  StitchInput in;
+  in.dt = &dt;
+  in.balls = balls;
+  in.crease_edges = edges;
+  in.options.max_rep_angle = std::max(options_.max_rep_angle, 1.2);
+  in.options.max_rep_ratio = 10;
+  std::vector<StitchFailure> failures;
+  absl::StatusOr<StitchResult> r = RipStitchCollar(in, &failures);
+  if (!r.ok()) return r.status();
+  stitch_report_ = *r;
+  stitched_.clear();
+  for (const auto& t : r->tets) {
+    stitched_.push_back({omega_.PointOf(VertexId(t[0])).value(), omega_.PointOf(VertexId(t[1])).value(),
+                         omega_.PointOf(VertexId(t[2])).value(), omega_.PointOf(VertexId(t[3])).value()});
+  }
+  stitched_done_ = true;
   return absl::OkStatus();
 }
 
@@ -1627,6 +1766,11 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     for (const auto& tri : facets_[f].InFacetTriangles()) {
       ConstrainedFace cf;
       for (int k = 0; k < 3; ++k) cf.v[k] = points_.VertexIn(tri[k], kOmegaMesh);
+      // Inside collars a facet point may be suppressed (never in M_Ω): its
+      // triangles are not faces of M_Ω (RipStitchCollar rebuilds them).
+      if (cf.v[0] == PointStore::kNoVertex || cf.v[1] == PointStore::kNoVertex || cf.v[2] == PointStore::kNoVertex) {
+        continue;
+      }
       cf.facet = f;
       faces.push_back(cf);
     }
@@ -1899,10 +2043,14 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   }
   out.input_vertex.resize(num_input_);
   for (uint32_t i = 0; i < num_input_; ++i) out.input_vertex[i] = duplicate_of_[i];
-  for (TetId t : dt.FiniteTets()) {
-    std::array<uint32_t, 4> tet;
-    for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
-    out.tets.push_back(tet);
+  if (stitched_done_) {
+    out.tets = stitched_;
+  } else {
+    for (TetId t : dt.FiniteTets()) {
+      std::array<uint32_t, 4> tet;
+      for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
+      out.tets.push_back(tet);
+    }
   }
   out.normalisation_translation = norm_.translation;
   out.normalisation_exponent = norm_.exponent;
@@ -1916,10 +2064,52 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     out.segment_chains.push_back(std::move(chain));
   }
 
-  for (uint32_t f = 0; f < facets_.size(); ++f) {
-    std::vector<std::array<uint32_t, 3>> tris;
-    for (const auto& tri : facets_[f].InFacetTriangles()) tris.push_back({tri[0].value(), tri[1].value(), tri[2].value()});
-    out.facet_triangles.push_back(std::move(tris));
+  if (!stitched_done_) {
+    for (uint32_t f = 0; f < facets_.size(); ++f) {
+      std::vector<std::array<uint32_t, 3>> tris;
+      for (const auto& tri : facets_[f].InFacetTriangles()) tris.push_back({tri[0].value(), tri[1].value(), tri[2].value()});
+      out.facet_triangles.push_back(std::move(tris));
+    }
+  } else {
+    // After RipStitchCollar: the facet meshes' in-facet triangles that are
+    // faces of the final tets (outside the collars), plus the stitched faces
+    // whose three vertices lie on one facet (inside: Theorem 4's proof).
+    std::vector<std::array<uint32_t, 3>> faces;
+    for (const auto& t : stitched_) {
+      for (int k = 0; k < 4; ++k) {
+        std::array<uint32_t, 3> fc{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
+        std::sort(fc.begin(), fc.end());
+        faces.push_back(fc);
+      }
+    }
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    auto on_facet = [&](uint32_t pid, uint32_t f) {
+      const PointId p(pid);
+      const FeatureId par = points_.Parent(p);
+      if (par == FeatureTable::Omega()) return false;
+      return FeatureContains(features_.OfFacet(f), p);
+    };
+    out.facet_triangles.assign(facets_.size(), {});
+    for (uint32_t f = 0; f < facets_.size(); ++f) {
+      for (const auto& tri : facets_[f].InFacetTriangles()) {
+        std::array<uint32_t, 3> k{tri[0].value(), tri[1].value(), tri[2].value()};
+        std::sort(k.begin(), k.end());
+        if (std::binary_search(faces.begin(), faces.end(), k)) out.facet_triangles[f].push_back(k);
+      }
+    }
+    for (const auto& k : faces) {
+      for (uint32_t f = 0; f < facets_.size(); ++f) {
+        if (!(on_facet(k[0], f) && on_facet(k[1], f) && on_facet(k[2], f))) continue;
+        // Only faces touching the inside of a collar are new; the rest came above.
+        if (!InsideCollars(std::array<PointId, 3>{PointId(k[0]), PointId(k[1]), PointId(k[2])}) &&
+            !(points_.IsCrease(PointId(k[0])) || points_.IsCrease(PointId(k[1])) || points_.IsCrease(PointId(k[2])))) {
+          continue;
+        }
+        auto& v = out.facet_triangles[f];
+        if (std::find(v.begin(), v.end(), k) == v.end()) v.push_back(k);
+      }
+    }
   }
   RefineStats& st = stats_;
   st.vertices = dt.NumVertices();
@@ -2070,6 +2260,10 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   // vertices, so a round converges and a few rounds settle region borders.
   bool any_volume = options.max_volume > 0;
   for (const plc::RegionSeed& sd : complex.regions) any_volume = any_volume || sd.max_volume > 0;
+  // The rounds label M_Ω by flooding across non-facet faces, which leaks
+  // through the collars until RipStitchCollar rebuilds them: stage (d) alone
+  // applies no max_volume (measured: example.poly flooded to "no tet left").
+  if (options.collars && !options.collar_surface) any_volume = false;
   for (int round = 0; any_volume && round < 64; ++round) {
     absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
     if (!more.ok()) return more.status();
@@ -2090,9 +2284,34 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
     s = refiner.Run();
     if (!s.ok()) return s;
   }
+  if (options.collars && options.collar_surface) {
+    // COLLAR events, then RipStitchCollar (Figure 3.2's last line).
+    for (int round = 0; round < 64; ++round) {
+      absl::StatusOr<bool> more = refiner.CollarRound();
+      if (!more.ok()) return more.status();
+      if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
+        const CollarSurfaceReport& r = refiner.surface_report_;
+        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u\n",
+                     round, r.repairs[0], r.repairs[1], r.repairs[2], r.repairs[3], r.bad_roots, r.bad_facets, r.bad_links,
+                     r.bad_sphere_links, r.empty_spheres, r.bad_circles, r.bad_boundaries, r.bad_angles,
+                     refiner.collar_repairs_, refiner.arc_repairs_);
+      }
+      if (!*more) break;
+      s = refiner.Run();
+      if (!s.ok()) return s;
+    }
+  }
   s = refiner.VerifyConformity();
   if (!s.ok()) return s;
-  return refiner.Output(input);
+  if (options.collars && options.collar_surface && refiner.collars().size() > 0) {
+    s = refiner.Stitch();
+    if (!s.ok()) return s;
+  }
+  PointSetRefinement out = refiner.Output(input);
+  out.stats.collar_rounds = refiner.collar_rounds_;
+  out.stats.collar_repairs = refiner.collar_repairs_;
+  out.stats.arc_repairs = refiner.arc_repairs_;
+  return out;
 }
 
 std::vector<ConstrainedFace> ConstrainedFacesOf(const PointSetRefinement& refined,

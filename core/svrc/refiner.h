@@ -53,6 +53,15 @@ struct RefineOptions {
   // conformity checks limited to elements outside the collars. Implies
   // attempt_creases.
   bool collars = false;
+  // Stage (e)/(f), experimental (docs/svrc-collars.md "Wiring status"):
+  // after the queues run dry, rounds of COLLAR events (CollarRepairs in M_Ω,
+  // ArcRepairs in the facet meshes), then RipStitchCollar on M_Ω; the output
+  // tets are the stitched ones. Off: the run ends after stage (d), and the
+  // mesh inside the collars is M_Ω's (not conforming there).
+  bool collar_surface = false;
+  // σ: the largest representation angle of the collar surface (radians;
+  // MeshParams::max_rep_angle).
+  double max_rep_angle = 0.5235987755982988;
   // Called at every poll: vertices in all meshes, pending events, radius of
   // the event about to be destroyed (the largest work radius). May be null.
   std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;
@@ -83,7 +92,10 @@ struct RefineStats {
   uint64_t max_collar_cells = 0;
   uint64_t suppressed_points = 0;  // unresolved points dropped inside collars (Figure 3.9)
   uint64_t points_12 = 0;          // (1,2) points: vertex-collar spheres ∩ segments
-  uint64_t collar_exempt = 0;      // pieces/triangles inside collars left to RipStitchCollar
+  uint64_t collar_exempt = 0;
+  uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)
+  uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
+  uint64_t arc_repairs = 0;        // points inserted on facet arcs      // pieces/triangles inside collars left to RipStitchCollar
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
