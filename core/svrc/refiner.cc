@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <map>
 #include <optional>
 #include <tuple>
 
@@ -1435,6 +1436,15 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   has_collar_[p.value()] = 1;
   const delaunay::Delaunay3& dt = omega_.dt();
   const Vec3 pos = points_.Xyz(p);
+  // A crease point strictly inside a collar (of its own crease, Lemma 13) is
+  // already protected; a ball of its own would sit inside that one, off the
+  // collar surface, and break the chain of consecutive balls RipStitchCollar
+  // builds books from (measured on crease_pair_30: the vertex collar crossed
+  // the ball of a non-adjacent crease point).
+  if (collars_.StrictlyInside(pos)) {
+    ++stats_.collars_skipped_inside;
+    return absl::OkStatus();
+  }
   // Figure 3.8 over M_Ω (guide: only M_Ω sees every feature's balls). A
   // cell's features: those of its linked ConfBalls (pieces, triangles,
   // unresolved points) and its own vertex's feature (resolved points have no
@@ -1563,7 +1573,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     if (near.empty()) continue;
     const FacetCollarSystem sys = FacetCollars(fr, near);
     ArcOptions aopt;
-    if (std::getenv("SVRC_ARC_LOOSE") != nullptr) {
+    if (options_.loose_arcs) {
       aopt.require_on_arc = false;
       aopt.eps = 0;
     }
@@ -1608,10 +1618,11 @@ absl::Status Refiner::StitchImpl() {
     uint32_t prev = CollarIndex::kNone;
     for (uint32_t v = 0; v != SegmentMesh::kNil; v = m.Next(v)) {
       const uint32_t b = ball_of_point[m.PointOf(v).value()];
-      if (b == CollarIndex::kNone) {
-        prev = CollarIndex::kNone;
-        continue;
-      }
+      // Crease points without a ball are inside a collar (CreateCollar skips
+      // them) or outside every collar; the first lie on the book's axis and
+      // are removed with the inside, the second break no pair whose spheres
+      // cross (the stitch ignores pairs that do not cross).
+      if (b == CollarIndex::kNone) continue;
       if (prev != CollarIndex::kNone) edges.emplace_back(std::min(prev, b), std::max(prev, b));
       prev = b;
     }
@@ -1624,6 +1635,18 @@ absl::Status Refiner::StitchImpl() {
   in.options.max_rep_ratio = 10;
   std::vector<StitchFailure> failures;
   absl::StatusOr<StitchResult> r = RipStitchCollar(in, &failures);
+  if (!r.ok() && std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
+    std::map<std::string, int> kinds;
+    for (const StitchFailure& f : failures) ++kinds[StitchFailureKindName(f.kind)];
+    for (const auto& [k, n] : kinds) std::fprintf(stderr, "stitch failure %s: %d\n", k.c_str(), n);
+    for (size_t i = 0; i < failures.size() && i < 5; ++i) std::fprintf(stderr, "  %s\n", failures[i].detail.c_str());
+    for (uint32_t i = 0; i < collars_.size(); ++i) {
+      const FeatureId f = points_.Parent(collar_centre_[i]);
+      std::fprintf(stderr, "ball %u: feature dim %d idx %u centre (%g %g %g) r %g\n", i, features_.Dim(f),
+                   features_.Index(f), collars_.ball(i).center.x, collars_.ball(i).center.y, collars_.ball(i).center.z,
+                   collars_.ball(i).radius);
+    }
+  }
   if (!r.ok()) return r.status();
   stitch_report_ = *r;
   stitched_.clear();

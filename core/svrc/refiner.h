@@ -59,6 +59,10 @@ struct RefineOptions {
   // tets are the stitched ones. Off: the run ends after stage (d), and the
   // mesh inside the collars is M_Ω's (not conforming there).
   bool collar_surface = false;
+  // Facet arcs checked for consistency and σ only (ArcOptions require_on_arc
+  // = false, eps = 0): the rounds converge, but arc chords are not
+  // guaranteed, so facets inside collars may not be sealed (measured).
+  bool loose_arcs = false;
   // σ: the largest representation angle of the collar surface (radians;
   // MeshParams::max_rep_angle).
   double max_rep_angle = 0.5235987755982988;
@@ -88,6 +92,7 @@ struct RefineStats {
   uint64_t size_rounds = 0;
   uint64_t collars = 0;            // collar balls created (stage (d))
   uint64_t vertex_collars = 0;     // of those, centred on an input vertex
+  uint64_t collars_skipped_inside = 0;  // crease points strictly inside a collar: no ball
   uint64_t collar_cells_explored = 0;  // FastCollarSize cells popped, summed (Lemma 35)
   uint64_t max_collar_cells = 0;
   uint64_t suppressed_points = 0;  // unresolved points dropped inside collars (Figure 3.9)

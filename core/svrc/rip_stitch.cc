@@ -312,6 +312,14 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
       if (!SphereSphereCircle(balls[i], balls[j], &c)) continue;
       const uint32_t k = find_pair(i, j);
       if (k == kNone) {
+        // A circle covered by the other balls is not on S (Definition 26):
+        // balls of non-consecutive points of one crease overlap inside the
+        // ball between them, which is no circle of the collar description.
+        std::vector<CollarBall> others;
+        for (uint32_t o : cand) {
+          if (o != i && o != j) others.push_back(balls[o]);
+        }
+        if (ClipCircleByBalls(c, others).empty()) continue;
         fail(Kind::kUnlistedCircle, CirclePoint(c, 0), i,
              absl::StrCat("spheres of balls ", i, " and ", j, " cross but are not a crease edge"));
       }

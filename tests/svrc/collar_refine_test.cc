@@ -12,6 +12,9 @@
 #include "core/plc/validate.h"
 #include "core/svrc/collar_size.h"
 #include "core/svrc/refiner.h"
+#include "core/mesh/conformity.h"
+#include "core/mesh/quality.h"
+#include "core/svrc/assemble.h"
 #include "gtest/gtest.h"
 #include "tests/test_support.h"
 
@@ -39,6 +42,7 @@ CollarRun Refine(const plc::Plc& plc, uint64_t cap) {
   opt.collars = true;
   opt.max_vertices = cap;
   opt.collar_surface = std::getenv("SVRC_COLLAR_SURFACE") != nullptr;
+  opt.loose_arcs = std::getenv("SVRC_ARC_LOOSE") != nullptr;
   if (const char* sg = std::getenv("SVRC_SIGMA")) opt.max_rep_angle = std::atof(sg) * M_PI / 180;
   run.refined = RefinePlc(run.complex, opt);
   return run;
@@ -148,8 +152,22 @@ TEST(CollarRefine, CorpusCreases) {
 TEST(CollarRefineDebug, One) {
   const char* a = getenv("SVRC_ANGLE");
   if (!a) GTEST_SKIP();
-  CollarRun run = Refine(plc::families::CreaseFacetPair(atof(a)), 400000);
+  const plc::Plc plc = plc::families::CreaseFacetPair(atof(a));
+  CollarRun run = Refine(plc, 400000);
   CheckCollars(run, "debug");
+  if (run.refined.ok() && std::getenv("SVRC_COLLAR_SURFACE") != nullptr) {
+    const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run.refined, run.complex);
+    mesh::MeshStats stats;
+    absl::StatusOr<OutputStageResult> out =
+        BuildOutputMesh(plc, run.refined->normalised_positions, run.refined->tets, run.complex.point_of_vertex, faces,
+                        CoordinateMapOf(*run.refined), false, &stats);
+    ASSERT_TRUE(out.ok()) << out.status();
+    const mesh::ConformityReport rep = mesh::CheckConformity(plc, out->mesh);
+    const mesh::QualityReport q = mesh::ComputeQuality(out->mesh);
+    std::printf("stitched: %zu tets, checker %s: %s; min dihedral %.2f max dihedral %.2f max radius-edge %.3f\n",
+                out->mesh.tets.size(), rep.ok() ? "OK" : "FAIL", rep.Summary().c_str(), q.all.dihedral_deg.min,
+                q.all.dihedral_deg.max, q.all.radius_edge.max);
+  }
   if (run.refined.ok()) {
     const RefineStats& st = run.refined->stats;
     std::printf("collars %zu (vertex %llu), vertices %llu, suppressed %llu, (1,2) %llu, cells explored %llu (max %llu), refine %.2f s\n",
