@@ -363,7 +363,7 @@ class Refiner {
  public:
   StitchResult stitch_report_;
   CollarSurfaceReport surface_report_;
-  uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0;
+  uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, chord_repairs_ = 0;
  private:
   RefineStats stats_;
   uint64_t budget_ = 0;
@@ -1424,7 +1424,9 @@ bool Refiner::InsideCollars(std::span<const PointId> verts) const {
   Vec3 c{0, 0, 0};
   for (PointId v : verts) {
     const Vec3& x = points_.Xyz(v);
-    if (collars_.StrictlyInside(x)) return true;
+    // A point constructed on S (collar dimension < 3) is on S even when its
+    // rounding put it strictly inside.
+    if (points_.CdOf(v).collar == 3 && collars_.StrictlyInside(x)) return true;
     c = c + x;
   }
   return collars_.StrictlyInside(c * (1.0 / static_cast<double>(verts.size())));
@@ -1542,6 +1544,21 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   std::stable_sort(reps.begin(), reps.end(), [](const CollarRepair& a, const CollarRepair& b) { return a.radius > b.radius; });
   bool any = false;
   const delaunay::Delaunay3& dt = omega_.dt();
+  // The edges of Del(M_Ω)|_S, for the facet chords below (computed before
+  // this round's 3D repairs change M_Ω: a chord found missing is re-checked
+  // next round).
+  std::vector<std::pair<uint32_t, uint32_t>> tprime_edges;
+  if (reps.empty()) {
+    const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt);
+    for (const RestrictedTriangle& t : restr.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t a = t.v[k].value(), b = t.v[(k + 1) % 3].value();
+        tprime_edges.emplace_back(std::min(a, b), std::max(a, b));
+      }
+    }
+    std::sort(tprime_edges.begin(), tprime_edges.end());
+    tprime_edges.erase(std::unique(tprime_edges.begin(), tprime_edges.end()), tprime_edges.end());
+  }
   for (const CollarRepair& r : reps) {
     const VertexId v = dt.NearestVertex(r.x);
     if (dt.Point(v) == r.x) continue;
@@ -1573,14 +1590,55 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     if (near.empty()) continue;
     const FacetCollarSystem sys = FacetCollars(fr, near);
     ArcOptions aopt;
+    aopt.snap = options_.arc_snap;
     if (options_.loose_arcs) {
       aopt.require_on_arc = false;
       aopt.eps = 0;
     }
-    std::vector<ArcRepair> ar = ArcRepairs(m.dt(), sys, options_.max_rep_angle, nullptr, aopt);
+    ArcReport arep;
+    std::vector<ArcRepair> ar = ArcRepairs(m.dt(), sys, options_.max_rep_angle, &arep, aopt);
+    if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr && !ar.empty()) {
+      std::fprintf(stderr, "  facet %u: %zu arc repairs: missing21 %d multi %d broken %d empty %d offarc %d angles %d size %d\n", f,
+                   ar.size(), arep.missing_points21, arep.multi_crossings, arep.broken_arcs, arep.empty_arcs,
+                   arep.off_arc_edges, arep.bad_angles, arep.too_large);
+    }
     std::stable_sort(ar.begin(), ar.end(), [](const ArcRepair& a, const ArcRepair& b) {
       return a.collar_dim < b.collar_dim || (a.collar_dim == b.collar_dim && a.radius > b.radius);
     });
+    // Theorem 4's facet case: the fan (crease point, chord) of RipStitchCollar
+    // covers F inside a collar only if every chord of F's arc chain is an
+    // edge of the restricted triangulation of S in M_Ω. A chord that is not
+    // gets the arc point between its ends (CD (2,2)), once the 3D surface and
+    // the arcs are otherwise consistent.
+    if (ar.empty() && reps.empty()) {
+      for (const ArcChain& ch : ArcChains(m.dt(), sys, aopt)) {
+        const size_t n = ch.vertices.size();
+        for (size_t i = 0; i + (ch.closed ? 0 : 1) < n; ++i) {
+          const VertexId2 x = ch.vertices[i], y = ch.vertices[(i + 1) % n];
+          const PointId a = m.PointOf(x), b = m.PointOf(y);
+          if (!points_.InMesh(a, kOmegaMesh) || !points_.InMesh(b, kOmegaMesh)) continue;
+          const uint32_t va = points_.VertexIn(a, kOmegaMesh), vb = points_.VertexIn(b, kOmegaMesh);
+          if (std::binary_search(tprime_edges.begin(), tprime_edges.end(),
+                                 std::pair(std::min(va, vb), std::max(va, vb)))) {
+            continue;
+          }
+          const PlaneCircle& pc = sys.circles[sys.arcs[ch.arc].circle];
+          const Vec2 px = m.dt().Point(x), py = m.dt().Point(y);
+          double ux = px.x - pc.center.x + py.x - pc.center.x, uy = px.y - pc.center.y + py.y - pc.center.y;
+          const double len = std::hypot(ux, uy);
+          if (!(len > 0)) continue;
+          const Vec2 mid{pc.center.x + pc.radius * ux / len, pc.center.y + pc.radius * uy / len};
+          ArcRepair r;
+          r.x = mid;
+          r.ball = sys.arcs[ch.arc].ball;
+          r.arc = ch.arc;
+          r.collar_dim = 2;
+          r.radius = 0.5 * std::hypot(px.x - py.x, px.y - py.y);
+          ar.push_back(r);
+          ++chord_repairs_;
+        }
+      }
+    }
     for (const ArcRepair& r : ar) {
       if (!(r.x.x >= m.SquareLo().x && r.x.x <= m.SquareHi().x && r.x.y >= m.SquareLo().y && r.x.y <= m.SquareHi().y)) continue;
       const VertexId2 w = m.dt().NearestVertex(r.x);
@@ -1631,7 +1689,9 @@ absl::Status Refiner::StitchImpl() {
   in.dt = &dt;
   in.balls = balls;
   in.crease_edges = edges;
-  in.options.max_rep_angle = std::max(options_.max_rep_angle, 1.2);
+  // The tets are verified positively oriented either way; the angle bound is
+  // checked by the rounds on snapped positions (Snap, thesis §3.1.2).
+  in.options.max_rep_angle = 1.5533430342749532;  // 89°
   in.options.max_rep_ratio = 10;
   std::vector<StitchFailure> failures;
   absl::StatusOr<StitchResult> r = RipStitchCollar(in, &failures);
@@ -2064,6 +2124,13 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     // through the exact-scale, one-rounding back map.
     out.positions[i] = i < num_input_ ? input[i] : norm_.Backward(points_.Xyz(PointId(i)));
   }
+  if (options_.collars) {
+    out.point_cd.resize(points_.size());
+    for (uint32_t i = 0; i < points_.size(); ++i) {
+      const Cd cd = points_.CdOf(PointId(i));
+      out.point_cd[i] = static_cast<uint8_t>(10 * cd.dim + cd.collar);
+    }
+  }
   out.input_vertex.resize(num_input_);
   for (uint32_t i = 0; i < num_input_; ++i) out.input_vertex[i] = duplicate_of_[i];
   if (stitched_done_) {
@@ -2314,10 +2381,10 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
       if (!more.ok()) return more.status();
       if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
         const CollarSurfaceReport& r = refiner.surface_report_;
-        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u\n",
+        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u chords %u\n",
                      round, r.repairs[0], r.repairs[1], r.repairs[2], r.repairs[3], r.bad_roots, r.bad_facets, r.bad_links,
                      r.bad_sphere_links, r.empty_spheres, r.bad_circles, r.bad_boundaries, r.bad_angles,
-                     refiner.collar_repairs_, refiner.arc_repairs_);
+                     refiner.collar_repairs_, refiner.arc_repairs_, refiner.chord_repairs_);
       }
       if (!*more) break;
       s = refiner.Run();

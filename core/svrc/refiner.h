@@ -63,6 +63,8 @@ struct RefineOptions {
   // = false, eps = 0): the rounds converge, but arc chords are not
   // guaranteed, so facets inside collars may not be sealed (measured).
   bool loose_arcs = false;
+  // Snap band of facet arcs, relative to the circle radius (thesis δ, §3.1.2).
+  double arc_snap = 0.02;
   // σ: the largest representation angle of the collar surface (radians;
   // MeshParams::max_rep_angle).
   double max_rep_angle = 0.5235987755982988;
@@ -158,6 +160,10 @@ struct PointSetRefinement {
     double radius = 0;
   };
   std::vector<Collar> collars;
+  // options.collars: per position, its containment dimension pair
+  // (Definition 37) as 10·CD + collar dimension, e.g. 22 for a point on a
+  // facet arc; and per position the Ω vertex it is (or none).
+  std::vector<uint8_t> point_cd;
   RefineStats stats;
 };
 

@@ -3,6 +3,7 @@
 // collar radius is g/3 against a brute-force g over the complex's features;
 // balls centred on different creases are disjoint (Lemma 13).
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,7 @@ CollarRun Refine(const plc::Plc& plc, uint64_t cap) {
   opt.max_vertices = cap;
   opt.collar_surface = std::getenv("SVRC_COLLAR_SURFACE") != nullptr;
   opt.loose_arcs = std::getenv("SVRC_ARC_LOOSE") != nullptr;
+  if (const char* sn = std::getenv("SVRC_ARC_SNAP")) opt.arc_snap = std::atof(sn);
   if (const char* sg = std::getenv("SVRC_SIGMA")) opt.max_rep_angle = std::atof(sg) * M_PI / 180;
   run.refined = RefinePlc(run.complex, opt);
   return run;
@@ -157,6 +159,52 @@ TEST(CollarRefineDebug, One) {
   CheckCollars(run, "debug");
   if (run.refined.ok() && std::getenv("SVRC_COLLAR_SURFACE") != nullptr) {
     const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run.refined, run.complex);
+    {
+      const auto& X = run.refined->normalised_positions;
+      auto area = [&](uint32_t a, uint32_t b, uint32_t c) { return 0.5 * geom::Norm(geom::Cross(X[b] - X[a], X[c] - X[a])); };
+      for (uint32_t f = 0; f < run.complex.facets.size(); ++f) {
+        double want = 0, got = 0;
+        for (const auto& t : run.complex.facets[f].triangles) want += area(t[0], t[1], t[2]);
+        for (const auto& t : run.refined->facet_triangles[f]) got += area(t[0], t[1], t[2]);
+        std::printf("facet %u: area %.9f covered %.9f (%zu faces)\n", f, want, got, run.refined->facet_triangles[f].size());
+        std::map<std::pair<uint32_t, uint32_t>, int> ecount;
+        for (const auto& t : run.refined->facet_triangles[f]) {
+          for (int k = 0; k < 3; ++k) ++ecount[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+        }
+        int shown = 0;
+        for (const auto& [e, n] : ecount) {
+          if (n != 1 || shown >= 8) continue;
+          const geom::Vec3 m = 0.5 * (X[e.first] + X[e.second]);
+          bool outline = false;
+          for (const auto& loop : run.complex.facets[f].loops) {
+            for (size_t q = 0; q < loop.size(); ++q) {
+              const geom::Vec3 &A = X[loop[q]], &B = X[loop[(q + 1) % loop.size()]];
+              const geom::Vec3 d = B - A;
+              const double t = std::clamp(geom::Dot(m - A, d) / geom::Dot(d, d), 0.0, 1.0);
+              if (geom::Dist(m, A + t * d) < 1e-9) outline = true;
+            }
+          }
+          if (outline) continue;
+          double best = 1e9;
+          int bi = -1;
+          for (size_t i = 0; i < run.refined->collars.size(); ++i) {
+            const auto& k = run.refined->collars[i];
+            const double d = geom::Dist(m, k.center) / k.radius;
+            if (d < best) { best = d; bi = (int)i; }
+          }
+          // boundary edges of the facet lie on its segments: skip those on the box/fin outline
+          int uses = 0;
+          for (const auto& t : run.refined->tets) {
+            int c = 0;
+            for (int q = 0; q < 4; ++q) c += (t[q] == e.first || t[q] == e.second);
+            uses += c == 2;
+          }
+          std::printf("   cd %d %d, tets on edge %d;", run.refined->point_cd[e.first], run.refined->point_cd[e.second], uses);
+          std::printf("   open edge %u-%u mid (%.5f %.5f %.5f) nearest collar %d at %.3f radii\n", e.first, e.second, m.x, m.y, m.z, bi, best);
+          ++shown;
+        }
+      }
+    }
     mesh::MeshStats stats;
     absl::StatusOr<OutputStageResult> out =
         BuildOutputMesh(plc, run.refined->normalised_positions, run.refined->tets, run.complex.point_of_vertex, faces,
