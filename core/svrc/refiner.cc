@@ -363,7 +363,8 @@ class Refiner {
  public:
   StitchResult stitch_report_;
   CollarSurfaceReport surface_report_;
-  uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, chord_repairs_ = 0;
+  uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, chord_repairs_ = 0, crossing_count_ = 0;
+  std::vector<std::pair<uint32_t, Vec2>> crossing_repairs_;  // (facet, uv) of this round
  private:
   RefineStats stats_;
   uint64_t budget_ = 0;
@@ -1548,6 +1549,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   // this round's 3D repairs change M_Ω: a chord found missing is re-checked
   // next round).
   std::vector<std::pair<uint32_t, uint32_t>> tprime_edges;
+  crossing_repairs_.clear();
   if (reps.empty()) {
     const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt);
     for (const RestrictedTriangle& t : restr.triangles) {
@@ -1558,6 +1560,36 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     }
     std::sort(tprime_edges.begin(), tprime_edges.end());
     tprime_edges.erase(std::unique(tprime_edges.begin(), tprime_edges.end()), tprime_edges.end());
+    // Facet-crossing check: RipStitchCollar's fan (centre, a, b) covers a
+    // facet F through a collar centre only if T′ meets F along F's own points.
+    // A T′ edge of ball i's partial sphere whose ends are strictly on opposite
+    // sides of such an F (inside F's region) gets F's arc point nearest to the
+    // crossing, CD (2,2) (docs/svrc-collars.md "Wiring status", item 5).
+    for (const RestrictedTriangle& t : restr.triangles) {
+      const PointId centre = collar_centre_[t.ball];
+      const CollarBall& ball = collars_.ball(t.ball);
+      for (uint32_t f = 0; f < facets_.size(); ++f) {
+        if (!FeatureContains(features_.OfFacet(f), centre)) continue;
+        const plc::FacetFrame& fr = frames_[f];
+        for (int k = 0; k < 3; ++k) {
+          const Vec3& pa = dt.Point(t.v[k]);
+          const Vec3& pb = dt.Point(t.v[(k + 1) % 3]);
+          const double ha = geom::Dot(pa - fr.origin, fr.normal), hb = geom::Dot(pb - fr.origin, fr.normal);
+          const double tol = 1e-12 * ball.radius;
+          if (!((ha > tol && hb < -tol) || (ha < -tol && hb > tol))) continue;
+          const Vec3 x = pa + (ha / (ha - hb)) * (pb - pa);
+          const Vec2 uv = fr.ToPlane(x), cuv = fr.ToPlane(ball.center);
+          const double hc = geom::Dot(ball.center - fr.origin, fr.normal);
+          const double rp2 = ball.radius * ball.radius - hc * hc;
+          if (!(rp2 > 0)) continue;
+          const double dx = uv.x - cuv.x, dy = uv.y - cuv.y, d = std::hypot(dx, dy);
+          if (!(d > 0)) continue;
+          const Vec2 q{cuv.x + std::sqrt(rp2) * dx / d, cuv.y + std::sqrt(rp2) * dy / d};
+          if (facets_[f].region().Locate(q) == FacetRegion::Where::kOutside) continue;
+          crossing_repairs_.push_back({f, q});
+        }
+      }
+    }
   }
   for (const CollarRepair& r : reps) {
     const VertexId v = dt.NearestVertex(r.x);
@@ -1610,6 +1642,19 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     // edge of the restricted triangulation of S in M_Ω. A chord that is not
     // gets the arc point between its ends (CD (2,2)), once the 3D surface and
     // the arcs are otherwise consistent.
+    for (const auto& [cf, q] : crossing_repairs_) {
+      if (cf != f || !ar.empty()) continue;
+      ArcRepair r;
+      r.x = q;
+      r.collar_dim = 2;
+      const VertexId2 w = m.dt().NearestVertex(q);
+      const Vec2 pw = m.dt().Point(w);
+      r.radius = std::hypot(pw.x - q.x, pw.y - q.y);
+      // Already sampled there (the crossing is within a tenth of the gap).
+      if (!(r.radius > 0)) continue;
+      ar.push_back(r);
+      ++crossing_count_;
+    }
     if (ar.empty() && reps.empty()) {
       for (const ArcChain& ch : ArcChains(m.dt(), sys, aopt)) {
         const size_t n = ch.vertices.size();
@@ -2381,10 +2426,10 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
       if (!more.ok()) return more.status();
       if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
         const CollarSurfaceReport& r = refiner.surface_report_;
-        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u chords %u\n",
+        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u chords %u crossings %u\n",
                      round, r.repairs[0], r.repairs[1], r.repairs[2], r.repairs[3], r.bad_roots, r.bad_facets, r.bad_links,
                      r.bad_sphere_links, r.empty_spheres, r.bad_circles, r.bad_boundaries, r.bad_angles,
-                     refiner.collar_repairs_, refiner.arc_repairs_, refiner.chord_repairs_);
+                     refiner.collar_repairs_, refiner.arc_repairs_, refiner.chord_repairs_, refiner.crossing_count_);
       }
       if (!*more) break;
       s = refiner.Run();
