@@ -50,36 +50,4 @@ uint32_t CollarIndex::FindContaining(const geom::Vec3& x) const {
   return best;
 }
 
-void CollarIndex::Candidates(const geom::Vec3& c, double r, std::vector<uint32_t>* out) const {
-  out->clear();
-  const Vec3 rv{r, r, r};
-  for (int32_t level : levels_) {
-    const Key lo = KeyOf(level, c - rv), hi = KeyOf(level, c + rv);
-    // A query much larger than the level's cells: scan its balls instead.
-    if ((hi.x - lo.x + 1) * (hi.y - lo.y + 1) * (hi.z - lo.z + 1) > 512) {
-      for (uint32_t id = 0; id < size(); ++id) {
-        if (LevelOf(balls_[id].radius) != level) continue;
-        out->push_back(id);
-      }
-      continue;
-    }
-    for (int64_t x = lo.x; x <= hi.x; ++x) {
-      for (int64_t y = lo.y; y <= hi.y; ++y) {
-        for (int64_t z = lo.z; z <= hi.z; ++z) {
-          auto it = grid_.find(Key{level, x, y, z});
-          if (it != grid_.end()) out->insert(out->end(), it->second.begin(), it->second.end());
-        }
-      }
-    }
-  }
-  std::sort(out->begin(), out->end());
-  out->erase(std::unique(out->begin(), out->end()), out->end());
-  // Exact box overlap filter.
-  std::erase_if(*out, [&](uint32_t id) {
-    const CollarBall& b = balls_[id];
-    return std::abs(b.center.x - c.x) > b.radius + r || std::abs(b.center.y - c.y) > b.radius + r ||
-           std::abs(b.center.z - c.z) > b.radius + r;
-  });
-}
-
 }  // namespace svrc::refine

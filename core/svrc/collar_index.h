@@ -27,9 +27,6 @@ class CollarIndex {
   // or kNone.
   uint32_t FindContaining(const geom::Vec3& x) const;
   bool StrictlyInside(const geom::Vec3& x) const { return FindContaining(x) != kNone; }
-  // Ids of every ball whose closed bounding box meets the box of B(c, r),
-  // ascending (candidates: callers decide with exact predicates).
-  void Candidates(const geom::Vec3& c, double r, std::vector<uint32_t>* out) const;
 
  private:
   struct Key {

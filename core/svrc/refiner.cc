@@ -200,6 +200,14 @@ class Refiner {
   double FeatureDistance(FeatureId f, PointId p, const Vec3& x) const;
   // Does feature f contain point p (an input point or a segment point)?
   bool FeatureContains(FeatureId f, PointId p) const;
+  // The facets containing crease point p (an input point or a point of a
+  // segment), ascending: the complex's incidence lists, no search.
+  std::span<const uint32_t> FacetsThrough(PointId p) const {
+    const FeatureId parent = points_.Parent(p);
+    if (features_.Dim(parent) == 0) return point_facets_[features_.Index(parent)];
+    if (features_.Dim(parent) == 1) return seg_facets_[features_.Index(parent)];
+    return {};
+  }
   const CollarIndex& collars() const { return collars_; }
   PointId CollarCentre(uint32_t i) const { return collar_centre_[i]; }
   // Features of the complex for oracles: 0 point, 1 segment, 2 facet.
@@ -1474,42 +1482,35 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
 
   // Figure 3.9: unresolved points now strictly inside the collar are dropped
   // (their links go; Suppressed() keeps them out from now on). M_Ω first.
-  std::vector<VertexId> cells;
-  CellsMeetingBall(pos, rho, nv, &cells);
+  // Unlinks the 0-balls of cell u of `mesh` that are now suppressed; returns
+  // whether any was (the cell's events need a refresh).
   std::vector<LocationObject> objs;
-  for (VertexId u : cells) {
+  auto drop_suppressed = [&](MeshId mesh, uint32_t u) {
     objs.clear();
-    blg_.ObjectsOf(kOmegaMesh, u.value(), &objs);
+    blg_.ObjectsOf(mesh, u, &objs);
     bool changed = false;
     for (const LocationObject& o : objs) {
       if (o.kind != ObjectKind::kBall || !balls_.IsVertexBall(BallId(o.id))) continue;
       const PointId q = balls_.VertexPoint(BallId(o.id));
-      if (points_.InMesh(q, kOmegaMesh) || !Suppressed(q)) continue;
-      blg_.RemoveLink(kOmegaMesh, u.value(), o);
+      if (points_.InMesh(q, mesh) || !Suppressed(q)) continue;
+      blg_.RemoveLink(mesh, u, o);
       changed = true;
     }
-    if (changed) RefreshEvents(u);
+    return changed;
+  };
+  std::vector<VertexId> cells;
+  CellsMeetingBall(pos, rho, nv, &cells);
+  for (VertexId u : cells) {
+    if (drop_suppressed(kOmegaMesh, u.value())) RefreshEvents(u);
   }
   // The facets through p: the collar's disk in each facet mesh.
   std::vector<VertexId2> cells2;
-  for (uint32_t f = 0; f < facets_.size(); ++f) {
-    if (!FeatureContains(features_.OfFacet(f), p)) continue;
+  for (uint32_t f : FacetsThrough(p)) {
     const Vec2 uv = Uv(f, p);
     const VertexId2 w = facets_[f].dt().NearestVertex(uv);
     CellsMeetingDisk(f, uv, rho, w, &cells2);
-    const std::vector<VertexId2> mine = cells2;
-    for (VertexId2 u : mine) {
-      objs.clear();
-      blg_.ObjectsOf(FacetMeshId(f), u.value(), &objs);
-      bool changed = false;
-      for (const LocationObject& o : objs) {
-        if (o.kind != ObjectKind::kBall || !balls_.IsVertexBall(BallId(o.id))) continue;
-        const PointId q = balls_.VertexPoint(BallId(o.id));
-        if (points_.InMesh(q, FacetMeshId(f)) || !Suppressed(q)) continue;
-        blg_.RemoveLink(FacetMeshId(f), u.value(), o);
-        changed = true;
-      }
-      if (changed) RefreshFacetEvents(f, u);
+    for (VertexId2 u : cells2) {
+      if (drop_suppressed(FacetMeshId(f), u.value())) RefreshFacetEvents(f, u);
     }
   }
   // Figure 3.7 line 10: every segment at a vertex collar gets the (1,2) point
@@ -1568,8 +1569,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     for (const RestrictedTriangle& t : restr.triangles) {
       const PointId centre = collar_centre_[t.ball];
       const CollarBall& ball = collars_.ball(t.ball);
-      for (uint32_t f = 0; f < facets_.size(); ++f) {
-        if (!FeatureContains(features_.OfFacet(f), centre)) continue;
+      for (uint32_t f : FacetsThrough(centre)) {
         const plc::FacetFrame& fr = frames_[f];
         for (int k = 0; k < 3; ++k) {
           const Vec3& pa = dt.Point(t.v[k]);

@@ -99,7 +99,6 @@ struct RefineStats {
   uint64_t max_collar_cells = 0;
   uint64_t suppressed_points = 0;  // unresolved points dropped inside collars (Figure 3.9)
   uint64_t points_12 = 0;          // (1,2) points: vertex-collar spheres ∩ segments
-  uint64_t collar_exempt = 0;
   uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
   uint64_t arc_repairs = 0;        // points inserted on facet arcs      // pieces/triangles inside collars left to RipStitchCollar

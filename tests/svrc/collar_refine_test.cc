@@ -11,7 +11,10 @@
 #include "core/plc/features.h"
 #include "core/plc/readers.h"
 #include "core/plc/validate.h"
+#include "core/svrc/collar_index.h"
 #include "core/svrc/collar_size.h"
+#include "core/geometry/predicates.h"
+#include <random>
 #include "core/svrc/refiner.h"
 #include "core/mesh/conformity.h"
 #include "core/mesh/quality.h"
@@ -113,6 +116,45 @@ void CheckCollars(const CollarRun& run, const std::string& what) {
       EXPECT_GE(geom::Dist(a.center, b.center), a.radius + b.radius) << what << " collars " << i << ", " << j;
     }
   }
+}
+
+// CollarIndex (the suppression test of Figure 3.9) against a linear scan:
+// radii over 8 decades, so balls land on many grid levels and straddle cells.
+TEST(CollarIndex, MatchesLinearScan) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1), e(-8, 0);
+  CollarIndex index;
+  std::vector<CollarBall> balls;
+  for (int i = 0; i < 400; ++i) {
+    const CollarBall b{{u(rng), u(rng), u(rng)}, std::pow(10.0, e(rng))};
+    balls.push_back(b);
+    EXPECT_EQ(index.Add(b), static_cast<uint32_t>(i));
+  }
+  int inside = 0;
+  for (int q = 0; q < 20000; ++q) {
+    // Half the queries near a ball (inside, on or just outside its sphere).
+    geom::Vec3 x{u(rng), u(rng), u(rng)};
+    if (q % 2 == 0) {
+      const CollarBall& b = balls[q % balls.size()];
+      const geom::Vec3 d{u(rng), u(rng), u(rng)};
+      x = b.center + (b.radius * (1 + 0.5 * u(rng)) / geom::Norm(d)) * d;
+    }
+    uint32_t want = CollarIndex::kNone;
+    for (uint32_t i = 0; i < balls.size() && want == CollarIndex::kNone; ++i) {
+      if (geom::InBall(x, balls[i].center, balls[i].radius) > 0) want = i;
+    }
+    ASSERT_EQ(index.FindContaining(x), want) << "query " << q;
+    inside += want != CollarIndex::kNone;
+  }
+  EXPECT_GT(inside, 5000);  // the test exercises hits, not only misses
+  // Strictly inside: a point on the sphere is not (Figure 3.9 suppresses
+  // points inside the collar, not on S); the lowest id wins.
+  CollarIndex two;
+  two.Add(CollarBall{{0, 0, 0}, 1});
+  two.Add(CollarBall{{0.5, 0, 0}, 1});
+  EXPECT_EQ(two.FindContaining({-1, 0, 0}), CollarIndex::kNone);
+  EXPECT_EQ(two.FindContaining({1, 0, 0}), 1u);
+  EXPECT_EQ(two.FindContaining({0.9, 0, 0}), 0u);
 }
 
 TEST(CollarRefine, CreaseFacetPairs) {
