@@ -198,20 +198,51 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   }
 
   // --- Face adjacency: sort the 4T faces by their vertex sets. --------------
-  std::vector<FaceRec> faces;
-  faces.reserve(4 * nt);
-  for (size_t t = 0; t < nt; ++t) {
-    const auto& tv = in.tets[t];
-    for (int f = 0; f < 4; ++f) {
-      std::array<uint32_t, 3> k{};
-      for (int i = 0, j = 0; i < 4; ++i) {
-        if (i != f) k[j++] = tv[i];
-      }
-      k = Sorted3(k);
-      faces.push_back({k[0], k[1], k[2], static_cast<uint32_t>(4 * t + f)});
+  // Order (a, b, c, slot) with a < b < c the face's sorted vertex ids. A
+  // counting sort on a (records enter in slot order, so each bucket is in
+  // slot order) and then a sort of each bucket by (b, c, slot): the same
+  // order as one comparison sort of all 4T records, in a fraction of the
+  // time (a bucket holds the ~20 faces whose smallest vertex is a).
+  std::vector<FaceRec> faces(4 * nt);
+  {
+    std::vector<uint32_t> bucket(nv + 1, 0);
+    // The faces of tet t from its sorted vertices s0 < s1 < s2 < s3: leaving
+    // out s_i gives a sorted face, slot 4t + (position of s_i in the tet).
+    auto for_faces = [&](size_t t, auto&& emit) {
+      const auto& tv = in.tets[t];
+      std::array<uint64_t, 4> s;
+      for (int i = 0; i < 4; ++i) s[i] = (static_cast<uint64_t>(tv[i]) << 2) | static_cast<uint64_t>(i);
+      // Sorting network on (vertex, position); positions break no ties
+      // between distinct vertices.
+      auto cswap = [&](int i, int j) {
+        if (s[j] < s[i]) std::swap(s[i], s[j]);
+      };
+      cswap(0, 1);
+      cswap(2, 3);
+      cswap(0, 2);
+      cswap(1, 3);
+      cswap(1, 2);
+      const uint32_t base = static_cast<uint32_t>(4 * t);
+      const uint32_t v0 = static_cast<uint32_t>(s[0] >> 2), v1 = static_cast<uint32_t>(s[1] >> 2),
+                     v2 = static_cast<uint32_t>(s[2] >> 2), v3 = static_cast<uint32_t>(s[3] >> 2);
+      emit(FaceRec{v1, v2, v3, base + static_cast<uint32_t>(s[0] & 3)});
+      emit(FaceRec{v0, v2, v3, base + static_cast<uint32_t>(s[1] & 3)});
+      emit(FaceRec{v0, v1, v3, base + static_cast<uint32_t>(s[2] & 3)});
+      emit(FaceRec{v0, v1, v2, base + static_cast<uint32_t>(s[3] & 3)});
+    };
+    for (size_t t = 0; t < nt; ++t) for_faces(t, [&](const FaceRec& r) { ++bucket[r.a + 1]; });
+    for (size_t v = 0; v < nv; ++v) bucket[v + 1] += bucket[v];
+    std::vector<uint32_t> fill(bucket.begin(), bucket.end() - 1);
+    for (size_t t = 0; t < nt; ++t) for_faces(t, [&](const FaceRec& r) { faces[fill[r.a]++] = r; });
+    auto bc_less = [](const FaceRec& x, const FaceRec& y) {
+      return x.b != y.b ? x.b < y.b : (x.c != y.c ? x.c < y.c : x.slot < y.slot);
+    };
+    for (size_t v = 0; v < nv; ++v) {
+      FaceRec* lo = faces.data() + bucket[v];
+      FaceRec* hi = faces.data() + bucket[v + 1];
+      if (hi - lo > 1) std::sort(lo, hi, bc_less);
     }
   }
-  std::sort(faces.begin(), faces.end(), FaceKeyLess);
   std::vector<uint32_t> nbr(4 * nt, kNoTet);  // slot -> opposite slot
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
