@@ -48,7 +48,10 @@ void LocationGraph::Arena<Entry>::Release(Span& s) {
   s = Span{};
 }
 
-LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
+inline LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
+  if (mesh.value() < cell_spans_.size() && cell < cell_spans_[mesh.value()].size()) [[likely]] {
+    return cell_spans_[mesh.value()][cell];
+  }
   if (cell_spans_.size() <= mesh.value()) {
     cell_spans_.resize(mesh.value() + 1);
     unresolved_.resize(mesh.value() + 1);
@@ -61,23 +64,23 @@ LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
   return spans[cell];
 }
 
-const LocationGraph::Span* LocationGraph::FindCellSpan(MeshId mesh, uint32_t cell) const {
+inline const LocationGraph::Span* LocationGraph::FindCellSpan(MeshId mesh, uint32_t cell) const {
   if (cell_spans_.size() <= mesh.value() || cell_spans_[mesh.value()].size() <= cell) return nullptr;
   return &cell_spans_[mesh.value()][cell];
 }
 
-LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
+inline LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
   std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
-  if (spans.size() <= object.id) spans.resize(object.id + 1);
+  if (spans.size() <= object.id) [[unlikely]] spans.resize(object.id + 1);
   return spans[object.id];
 }
 
-const LocationGraph::Span* LocationGraph::FindObjectSpan(LocationObject object) const {
+inline const LocationGraph::Span* LocationGraph::FindObjectSpan(LocationObject object) const {
   const std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
   return spans.size() <= object.id ? nullptr : &spans[object.id];
 }
 
-uint32_t LocationGraph::CellPos(const Span& cs, LocationObject object) const {
+inline uint32_t LocationGraph::CellPos(const Span& cs, LocationObject object) const {
   const CellEntry* e = cell_arena_.Data(cs);
   for (uint32_t i = 0; i < cs.size; ++i) {
     if (e[i].Is(object)) return i;
@@ -85,7 +88,7 @@ uint32_t LocationGraph::CellPos(const Span& cs, LocationObject object) const {
   return kNil;
 }
 
-uint32_t LocationGraph::ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const {
+inline uint32_t LocationGraph::ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const {
   const ObjectEntry* e = object_arena_.Data(os);
   for (uint32_t i = 0; i < os.size; ++i) {
     if (e[i].cell == cell && e[i].mesh == mesh.value()) return i;
@@ -104,7 +107,7 @@ bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) 
   return ObjectPos(*os, mesh, cell) != kNil;
 }
 
-uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t cell) {
+inline uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t cell) {
   uint32_t l;
   if (!free_records_.empty()) {
     l = free_records_.back();
@@ -117,18 +120,23 @@ uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t c
   return l;
 }
 
-void LocationGraph::FreeRecord(uint32_t l) { free_records_.push_back(l); }
+inline void LocationGraph::FreeRecord(uint32_t l) { free_records_.push_back(l); }
 
 AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject object,
                                      const LinkFacts& facts, BallStore* balls) {
   AddLinkResult result;
-  if (IsLinked(mesh, cell, object)) {
+  // One lookup per side (the spans are created here if new; an empty span
+  // is no link). The duplicate test scans the shorter array, as IsLinked.
+  Span& cs = CellSpan(mesh, cell);
+  Span& os = ObjectSpan(object);
+  if (cs.size != 0 && os.size != 0 &&
+      (cs.size <= os.size ? CellPos(cs, object) : ObjectPos(os, mesh, cell)) != kNil) {
     ++stats_.duplicates_refused;
     return result;
   }
   const uint32_t l = NewRecord(object, mesh, cell);
-  cell_arena_.Append(CellSpan(mesh, cell), CellEntry{object.id, object.kind, facts.unresolved});
-  object_arena_.Append(ObjectSpan(object), ObjectEntry{mesh.value(), cell, l});
+  cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved});
+  object_arena_.Append(os, ObjectEntry{mesh.value(), cell, l});
   ++num_links_;
   ++stats_.links_added;
   result.link = LinkId(l);
