@@ -755,6 +755,19 @@ VertexId Delaunay3::NearestVertex(const Vec3& p, TetId hint) const {
   }
 }
 
+VertexId Delaunay3::VertexAt(const Vec3& p, TetId hint) const {
+  if (!Is3d()) return kNoneVertex;
+  // Locate returns a finite tet whose closure holds p, or the ghost whose
+  // hull face p is strictly beyond (then no vertex is at p; its finite
+  // vertices are checked anyway).
+  const uint32_t t = Locate(p, hint).value();
+  for (int i = 0; i < 4; ++i) {
+    const uint32_t w = tets_[8 * t + i];
+    if (w != kInf && points_[w] == p) return VertexId(w);
+  }
+  return kNoneVertex;
+}
+
 Vec3 Delaunay3::Circumcenter(TetId t) const {
   const uint32_t* v = &tets_[8 * t.value()];
   const Vec3 a = points_[v[0]];

@@ -198,6 +198,12 @@ class Delaunay3 {
   // The vertex nearest to p (ties: smallest vertex id): walk + greedy descent
   // on the Delaunay graph. kNoneVertex while !Is3d().
   VertexId NearestVertex(const Vec3& p, TetId hint = kNoneTet) const;
+  // The vertex whose point is exactly p, or kNoneVertex (also while
+  // !Is3d()): one Locate and coordinate comparisons, no distance predicate.
+  // A vertex at p is a vertex of every tet whose closure contains p, so this
+  // is NearestVertex(p) when Point(NearestVertex(p)) == p and kNoneVertex
+  // otherwise — the cheap form of "is p already a vertex?".
+  VertexId VertexAt(const Vec3& p, TetId hint = kNoneTet) const;
 
   // --- Tet constructions (finite tets) -----------------------------------------
 

@@ -437,6 +437,34 @@ TEST(Delaunay3Test, QueriesMatchBruteForce) {
   EXPECT_EQ(dt.NearestVertex(Vec3(-100, 0.5, 0.5)).valid(), true);
 }
 
+// VertexAt(p) is NearestVertex(p) exactly when a vertex sits at p, else none:
+// on every vertex (grid points lie on faces and edges of many tets, so
+// Locate may return any tet of the star), on circumcentres (equidistant from
+// four vertices, the refiner's phantom-corner query), on midpoints of grid
+// edges and on random points, with and without hints.
+TEST(Delaunay3Test, VertexAtMatchesNearestVertex) {
+  const auto grid = Grid(4);
+  Delaunay3 dt;
+  for (uint32_t i = 0; i < grid.size(); ++i) dt.Insert(grid[i], i);
+  std::vector<Vec3> queries = grid;
+  for (TetId t : dt.FiniteTets()) queries.push_back(dt.Circumcenter(t));
+  for (size_t i = 0; i + 1 < grid.size(); ++i) queries.push_back(0.5 * (grid[i] + grid[i + 1]));
+  for (const Vec3& q : RandomPoints(200, 5)) queries.push_back(q);
+  queries.push_back(Vec3(-3, 0.5, 0.5));  // outside the hull
+  int at_vertex = 0;
+  for (size_t k = 0; k < queries.size(); ++k) {
+    const Vec3& q = queries[k];
+    const VertexId near = dt.NearestVertex(q);
+    const VertexId want = dt.Point(near) == q ? near : kNoneVertex;
+    EXPECT_EQ(dt.VertexAt(q), want) << k;
+    const TetId hint(static_cast<uint32_t>(k * 7919) % dt.TetCapacity());
+    EXPECT_EQ(dt.VertexAt(q, dt.IsAlive(hint) ? hint : kNoneTet), want) << k;
+    at_vertex += want.valid();
+  }
+  EXPECT_GE(at_vertex, static_cast<int>(grid.size()));
+  EXPECT_FALSE(Delaunay3().VertexAt(Vec3(0, 0, 0)).valid());
+}
+
 TEST(Delaunay3Test, Large100kEmptySphere) {
   const auto pts = RandomPoints(100000, 21);
   const auto order = BrioOrder(HilbertOrder(pts));
