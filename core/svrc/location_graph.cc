@@ -64,11 +64,6 @@ inline LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) 
   return spans[cell];
 }
 
-inline const LocationGraph::Span* LocationGraph::FindCellSpan(MeshId mesh, uint32_t cell) const {
-  if (cell_spans_.size() <= mesh.value() || cell_spans_[mesh.value()].size() <= cell) return nullptr;
-  return &cell_spans_[mesh.value()][cell];
-}
-
 inline LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
   std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
   if (spans.size() <= object.id) [[unlikely]] spans.resize(object.id + 1);

@@ -72,6 +72,18 @@ class LocationGraph {
 
   // Balls_F(v): balls linked to cell v of mesh F, in link order.
   void BallsOf(MeshId mesh, uint32_t cell, std::vector<BallId>* out) const;
+  // The same balls, in the same order, passed to f(BallId) without a copy
+  // (Destroy's line 3 unions them over 𝒱 at once). f must not change the
+  // graph.
+  template <typename F>
+  void ForEachBall(MeshId mesh, uint32_t cell, F&& f) const {
+    const Span* cs = FindCellSpan(mesh, cell);
+    if (cs == nullptr) return;
+    const CellEntry* e = cell_arena_.Data(*cs);
+    for (uint32_t i = 0, n = cs->size; i < n; ++i) {
+      if (e[i].kind == ObjectKind::kBall) f(BallId(e[i].object_id));
+    }
+  }
   // All objects linked to cell v of mesh F, in link order.
   void ObjectsOf(MeshId mesh, uint32_t cell, std::vector<LocationObject>* out) const;
   // Cells_F'(O): cells of mesh F' linked to O, in link order.
@@ -151,7 +163,10 @@ class LocationGraph {
   };
 
   Span& CellSpan(MeshId mesh, uint32_t cell);
-  const Span* FindCellSpan(MeshId mesh, uint32_t cell) const;
+  const Span* FindCellSpan(MeshId mesh, uint32_t cell) const {
+    if (cell_spans_.size() <= mesh.value() || cell_spans_[mesh.value()].size() <= cell) return nullptr;
+    return &cell_spans_[mesh.value()][cell];
+  }
   Span& ObjectSpan(LocationObject object);
   const Span* FindObjectSpan(LocationObject object) const;
   // Position of `object` in the cell's array / of (mesh, cell) in the

@@ -330,6 +330,9 @@ void ExpectSameAsModel(const LocationGraph& g, const BlgModel& model, int meshes
       }
       g.BallsOf(MeshId(m), c, &got_balls);
       ASSERT_EQ(got_balls, want_balls) << "BallsOf mesh " << m << " cell " << c << " step " << step;
+      std::vector<BallId> each;
+      g.ForEachBall(MeshId(m), c, [&](BallId b) { each.push_back(b); });
+      ASSERT_EQ(each, want_balls) << "ForEachBall mesh " << m << " cell " << c << " step " << step;
       ASSERT_EQ(g.NumUnresolved(MeshId(m), c), want_unresolved) << "mesh " << m << " cell " << c;
     }
   }
