@@ -102,20 +102,10 @@ bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) 
   return ObjectPos(*os, mesh, cell) != kNil;
 }
 
-inline uint32_t LocationGraph::NewRecord(LocationObject object, MeshId mesh, uint32_t cell) {
-  uint32_t l;
-  if (!free_records_.empty()) {
-    l = free_records_.back();
-    free_records_.pop_back();
-  } else {
-    l = static_cast<uint32_t>(records_.size());
-    records_.emplace_back();
-  }
-  records_[l] = LinkRecord{object, mesh.value(), cell};
-  return l;
+inline uint32_t LocationGraph::NewLinkId() {
+  if (next_link_ == LinkId::kNoneValue) [[unlikely]] next_link_ = 0;
+  return next_link_++;
 }
-
-inline void LocationGraph::FreeRecord(uint32_t l) { free_records_.push_back(l); }
 
 AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject object,
                                      const LinkFacts& facts, BallStore* balls) {
@@ -129,7 +119,7 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
     ++stats_.duplicates_refused;
     return result;
   }
-  const uint32_t l = NewRecord(object, mesh, cell);
+  const uint32_t l = NewLinkId();
   cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved});
   object_arena_.Append(os, ObjectEntry{mesh.value(), cell, l});
   ++num_links_;
@@ -155,7 +145,6 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
 
 void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshId mesh, uint32_t cell) {
   if (cell_arena_.Data(cs)[ci].unresolved) --unresolved_[mesh.value()][cell];
-  FreeRecord(object_arena_.Data(os)[oi].link);
   cell_arena_.Erase(cs, ci);
   object_arena_.Erase(os, oi);
   --num_links_;
@@ -163,17 +152,22 @@ void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshI
 }
 
 void LocationGraph::RemoveLink(LinkId id) {
-  if (!id.valid() || id.value() >= records_.size()) return;
-  const LinkRecord rec = records_[id.value()];
-  const MeshId mesh(rec.mesh);
-  // A freed record keeps its old ends: act only if the link still lives.
-  const Span* cs = FindCellSpan(mesh, rec.cell);
-  const Span* os = FindObjectSpan(rec.object);
-  if (cs == nullptr || os == nullptr) return;
-  const uint32_t oi = ObjectPos(*os, mesh, rec.cell);
-  if (oi == kNil || object_arena_.Data(*os)[oi].link != id.value()) return;
-  const uint32_t ci = CellPos(*cs, rec.object);
-  RemoveAt(cell_spans_[rec.mesh][rec.cell], ci, ObjectSpan(rec.object), oi, mesh, rec.cell);
+  if (!id.valid()) return;
+  for (int kind = 0; kind < 2; ++kind) {
+    const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
+    for (uint32_t o = 0; o < spans.size(); ++o) {
+      const ObjectEntry* e = object_arena_.Data(spans[o]);
+      for (uint32_t i = 0; i < spans[o].size; ++i) {
+        if (e[i].link != id.value()) continue;
+        const LocationObject object{static_cast<ObjectKind>(kind), o};
+        const MeshId mesh(e[i].mesh);
+        const uint32_t cell = e[i].cell;
+        RemoveAt(cell_spans_[mesh.value()][cell], CellPos(cell_spans_[mesh.value()][cell], object),
+                 ObjectSpan(object), i, mesh, cell);
+        return;
+      }
+    }
+  }
 }
 
 bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object) {
@@ -199,9 +193,7 @@ void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<Loca
     if (removed != nullptr) removed->push_back(object);
     if (e[i].unresolved) ++unresolved;
     Span& os = ObjectSpan(object);
-    const uint32_t oi = ObjectPos(os, mesh, cell);
-    FreeRecord(object_arena_.Data(os)[oi].link);
-    object_arena_.Erase(os, oi);
+    object_arena_.Erase(os, ObjectPos(os, mesh, cell));
   }
   unresolved_[mesh.value()][cell] -= unresolved;
   num_links_ -= cs.size;
@@ -227,7 +219,6 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
     const uint32_t ci = CellPos(cs, object);
     if (cell_arena_.Data(cs)[ci].unresolved) --unresolved_[oe.mesh][oe.cell];
     cell_arena_.Erase(cs, ci);
-    FreeRecord(oe.link);
     --num_links_;
     ++stats_.links_removed;
   }
@@ -267,10 +258,7 @@ uint32_t LocationGraph::NumUnresolved(MeshId mesh, uint32_t cell) const {
 
 bool LocationGraph::Validate() const {
   // Cell side: each entry must have its partner (mesh, cell) in the object's
-  // array, whose record names this (object, mesh, cell); every record must be
-  // reached exactly once. A duplicate object in a cell reaches the same
-  // record twice and fails.
-  std::vector<uint8_t> seen_cell(records_.size(), 0), seen_obj(records_.size(), 0);
+  // array. A duplicate object in a cell is caught from the object side.
   uint64_t count = 0;
   for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
     for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
@@ -279,24 +267,18 @@ bool LocationGraph::Validate() const {
       const CellEntry* e = cell_arena_.Data(cs);
       uint32_t unresolved = 0;
       for (uint32_t i = 0; i < cs.size; ++i) {
-        const LocationObject o = e[i].object();
-        const Span* os = FindObjectSpan(o);
-        if (os == nullptr) return false;
-        const uint32_t oi = ObjectPos(*os, MeshId(m), c);
-        if (oi == kNil) return false;
-        const uint32_t l = object_arena_.Data(*os)[oi].link;
-        if (l >= records_.size()) return false;
-        const LinkRecord& rec = records_[l];
-        if (rec.cell != c || rec.mesh != m || !(rec.object == o)) return false;
-        if (seen_cell[l]++) return false;
+        const Span* os = FindObjectSpan(e[i].object());
+        if (os == nullptr || ObjectPos(*os, MeshId(m), c) == kNil) return false;
         if (e[i].unresolved) ++unresolved;
         ++count;
       }
       if (unresolved_[m][c] != unresolved) return false;
     }
   }
-  // Object side: each entry's record names this object and its (mesh, cell),
-  // and the cell's array holds the object exactly once.
+  // Object side: no (mesh, cell) twice in an object's array, the cell's
+  // array holds the object exactly once, and every link id is distinct.
+  std::vector<uint32_t> ids;
+  uint64_t object_count = 0;
   for (int kind = 0; kind < 2; ++kind) {
     const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
     for (uint32_t id = 0; id < spans.size(); ++id) {
@@ -305,31 +287,24 @@ bool LocationGraph::Validate() const {
       const LocationObject o{static_cast<ObjectKind>(kind), id};
       const ObjectEntry* e = object_arena_.Data(os);
       for (uint32_t i = 0; i < os.size; ++i) {
-        const uint32_t l = e[i].link;
-        if (l >= records_.size()) return false;
-        const LinkRecord& rec = records_[l];
-        if (rec.cell != e[i].cell || rec.mesh != e[i].mesh || !(rec.object == o)) return false;
-        if (seen_obj[l]++) return false;
+        if (e[i].link == LinkId::kNoneValue) return false;
+        ids.push_back(e[i].link);
+        for (uint32_t j = 0; j < i; ++j) {
+          if (e[j].mesh == e[i].mesh && e[j].cell == e[i].cell) return false;
+        }
         const Span* cs = FindCellSpan(MeshId(e[i].mesh), e[i].cell);
         if (cs == nullptr) return false;
         const CellEntry* ce = cell_arena_.Data(*cs);
         uint32_t found = 0;
         for (uint32_t j = 0; j < cs->size; ++j) found += ce[j].Is(o) ? 1 : 0;
         if (found != 1) return false;
+        ++object_count;
       }
     }
   }
-  // Every record is either live (reached once from each side) or on the free
-  // stack once (reached from neither).
-  std::vector<uint8_t> is_free(records_.size(), 0);
-  for (uint32_t l : free_records_) {
-    if (l >= records_.size() || is_free[l]++) return false;
-  }
-  for (uint32_t l = 0; l < records_.size(); ++l) {
-    const bool live = seen_cell[l] == 1 && seen_obj[l] == 1;
-    if (live == (is_free[l] == 1) || (!live && (seen_cell[l] != 0 || seen_obj[l] != 0))) return false;
-  }
-  return count == num_links_ && free_records_.size() + num_links_ == records_.size();
+  std::sort(ids.begin(), ids.end());
+  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return false;
+  return count == num_links_ && object_count == num_links_;
 }
 
 }  // namespace svrc::refine

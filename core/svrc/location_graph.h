@@ -10,9 +10,10 @@
 // arena (power-of-two capacities, recycled through per-size free lists). Adds
 // append at the end and removals shift the tail down by one, so iteration
 // order is the order of AddLink calls (deterministic; the refiner's output
-// depends on it). A small pool of {object, mesh, cell} records gives each
-// link a LinkId for RemoveLink(LinkId). A query walks one short array (bounded
-// ply, Lemma 6) instead of chasing one pointer per link.
+// depends on it). Each link gets a fresh LinkId from a counter, kept in its
+// object-side entry (no per-link record to write and free: the refiner never
+// removes by LinkId; RemoveLink(LinkId) searches). A query walks one short
+// array (bounded ply, Lemma 6) instead of chasing one pointer per link.
 #pragma once
 
 #include <cstdint>
@@ -59,7 +60,10 @@ class LocationGraph {
   // (returns an invalid link): links are sets (Lemma 36 counts unique pairs).
   AddLinkResult AddLink(MeshId mesh, uint32_t cell, LocationObject object, const LinkFacts& facts,
                         BallStore* balls);
-  // RemoveLink: deletes both directions.
+  // RemoveLink: deletes both directions. Time linear in the number of links
+  // (tests and debugging; the refiner removes by cell or object). An id
+  // whose link is gone removes nothing (ids are not reused before 2^32 − 1
+  // further links).
   void RemoveLink(LinkId link);
   // Removes the link (mesh, cell, object) if present; returns whether it was.
   bool RemoveLink(MeshId mesh, uint32_t cell, LocationObject object);
@@ -96,9 +100,9 @@ class LocationGraph {
 
   // Both directions agree: every link is in exactly its object's array and
   // its cell's array, each entry of either side has its partner on the other
-  // side and in the link records, unresolved counters match, no duplicate
-  // (object, mesh, cell). Time linear in links × array length. For tests and
-  // debug builds.
+  // side, link ids are distinct, unresolved counters match, no duplicate
+  // (object, mesh, cell). Time linear in links × array length (plus a sort of
+  // the ids). For tests and debug builds.
   bool Validate() const;
 
   struct Stats {
@@ -147,19 +151,11 @@ class LocationGraph {
     LocationObject object() const { return {kind, object_id}; }
     bool Is(LocationObject o) const { return object_id == o.id && kind == o.kind; }
   };
-  // The object side: which cell of which mesh, and the link's record.
+  // The object side: which cell of which mesh, and the link's id.
   struct ObjectEntry {
     uint32_t mesh = 0;
     uint32_t cell = 0;
     uint32_t link = 0;
-  };
-  // LinkId → its ends (RemoveLink(LinkId), Validate). Freeing a record only
-  // pushes its id on a stack; a LinkId is live iff its object's entry for
-  // (mesh, cell) names it, so a stale id removes nothing.
-  struct LinkRecord {
-    LocationObject object;
-    uint32_t mesh = kNil;
-    uint32_t cell = kNil;
   };
 
   Span& CellSpan(MeshId mesh, uint32_t cell);
@@ -173,16 +169,14 @@ class LocationGraph {
   // object's array; kNil when absent.
   uint32_t CellPos(const Span& cs, LocationObject object) const;
   uint32_t ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const;
-  uint32_t NewRecord(LocationObject object, MeshId mesh, uint32_t cell);
-  void FreeRecord(uint32_t l);
+  uint32_t NewLinkId();
   // Removes entry `oi` of the object's array and entry `ci` of the cell's
   // array, which must be the same link.
   void RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshId mesh, uint32_t cell);
 
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;
-  std::vector<LinkRecord> records_;
-  std::vector<uint32_t> free_records_;  // LIFO: the next link reuses the last freed id
+  uint32_t next_link_ = 0;  // the next LinkId (skips kNone)
   uint32_t num_links_ = 0;
   std::vector<std::vector<Span>> cell_spans_;      // [mesh][cell]
   std::vector<std::vector<uint32_t>> unresolved_;  // [mesh][cell]
