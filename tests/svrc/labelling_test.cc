@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <random>
 
+#include "absl/strings/str_cat.h"
 #include "core/geometry/predicates.h"
 #include "gtest/gtest.h"
 #include "tests/svrc/output_test_util.h"
@@ -300,6 +301,38 @@ TEST(LabellingTest, Errors) {
   l = LabelRegions(in);
   EXPECT_EQ(l.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(l.status().message().find("tets"), std::string::npos);
+  // The message names the smallest such face (sorted ids) and its three
+  // smallest tets, as a sort of all (face, slot) records finds them; here
+  // with the copy of the tet in front, so the copy has the smaller ids.
+  tets = g.tets;
+  tets.insert(tets.begin(), g.tets[3]);
+  in.tets = tets;
+  {
+    std::vector<std::array<uint32_t, 4>> recs;  // a, b, c, slot
+    for (uint32_t t = 0; t < tets.size(); ++t) {
+      for (uint32_t f = 0; f < 4; ++f) {
+        std::array<uint32_t, 3> k;
+        for (uint32_t i = 0, j = 0; i < 4; ++i) {
+          if (i != f) k[j++] = tets[t][i];
+        }
+        std::sort(k.begin(), k.end());
+        recs.push_back({k[0], k[1], k[2], 4 * t + f});
+      }
+    }
+    std::sort(recs.begin(), recs.end());
+    size_t i = 0;
+    while (!(recs[i][0] == recs[i + 2][0] && recs[i][1] == recs[i + 2][1] && recs[i][2] == recs[i + 2][2])) ++i;
+    size_t n = 3;
+    while (i + n < recs.size() && recs[i + n][0] == recs[i][0] && recs[i + n][1] == recs[i][1] &&
+           recs[i + n][2] == recs[i][2]) {
+      ++n;
+    }
+    const std::string want = absl::StrCat("face (", recs[i][0], ", ", recs[i][1], ", ", recs[i][2], ") is in ", n,
+                                          " tets (", recs[i][3] / 4, ", ", recs[i + 1][3] / 4, ", ",
+                                          recs[i + 2][3] / 4, ", ...): not a tetrahedralization");
+    l = LabelRegions(in);
+    EXPECT_EQ(l.status().message(), want);
+  }
   // A vertex id out of range.
   tets = g.tets;
   tets[5][2] = 1000;
