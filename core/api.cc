@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/delaunay/point_set.h"
 #include "core/geometry/predicates.h"
+#include "core/mesh/conformity.h"
 #include "core/plc/validate.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
@@ -179,33 +180,38 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     report("refine", vertices, queue, radius);
   };
   report("refine", 0, 0, 0);
-  // Creases (Definitions 4-5) need collars (issue #6, not built). Until then
-  // a creased PLC is refined through its creases under a small vertex budget
-  // (kCreaseBudget): mild creases often finish and then pass the conformity
-  // checker (b_internal/example.poly, 63°); the others end FAILED_PRECONDITION
-  // naming the first crease instead of refining towards the full budget.
+  // Creases (Definitions 4-5). Mild ones (>= kCollarAngleDeg) are refined
+  // through under a small vertex budget (kCreaseBudget): they finish and pass
+  // the conformity checker (b_internal/example.poly, 63°; tetra.poly). Sharper
+  // ones get collars (thesis §3.1.2, stages (d)-(f): collar balls, COLLAR
+  // events on the collar surface, RipStitchCollar); the stitched mesh is
+  // checked before it is returned (below), and an input the collar stage
+  // cannot finish yet ends FAILED_PRECONDITION naming its sharpest crease.
   double sharpest = 90;
   const std::string crease = FirstCrease(*complex, &sharpest);
-  // Below this angle refinement without collars is hopeless (two facets at a
-  // small angle encroach each other's balls at every scale, thesis §1.4):
-  // refuse at once.
-  constexpr double kAttemptAngleDeg = 45;
-  if (!crease.empty() && sharpest < kAttemptAngleDeg) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "SVRC: ", crease, "; creases below ", kAttemptAngleDeg,
-        " degrees need collars (issue #6), not implemented yet"));
-  }
-  if (!crease.empty()) {
+  constexpr double kCollarAngleDeg = 45;
+  const bool use_collars = !crease.empty() && sharpest < kCollarAngleDeg;
+  if (use_collars) {
+    options.collars = true;
+    options.collar_surface = true;
+    options.max_rep_angle = params.max_rep_angle * M_PI / 180;
+  } else if (!crease.empty()) {
     options.attempt_creases = true;
     const uint64_t crease_budget = 20000 + 4 * static_cast<uint64_t>(complex->points.size());
     if (options.max_vertices == 0 || options.max_vertices > crease_budget) options.max_vertices = crease_budget;
   }
   absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
   if (!refined.ok()) {
-    if (!crease.empty() && refined.status().code() == absl::StatusCode::kResourceExhausted) {
+    if (!crease.empty() && !use_collars && refined.status().code() == absl::StatusCode::kResourceExhausted) {
       return absl::FailedPreconditionError(absl::StrCat(
           "SVRC: ", crease, "; refinement without collars did not finish within ", options.max_vertices,
-          " vertices (creases need collars, issue #6, not implemented yet)"));
+          " vertices"));
+    }
+    if (use_collars && (refined.status().code() == absl::StatusCode::kResourceExhausted ||
+                        refined.status().code() == absl::StatusCode::kFailedPrecondition)) {
+      return absl::FailedPreconditionError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
+                                                        " degrees): the collar stage did not finish: ",
+                                                        refined.status().message()));
     }
     return refined.status();
   }
@@ -220,6 +226,16 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   sliver.max_radius_edge = params.radius_edge;
   sliver.keep_max_volume = params.max_volume > 0 || std::any_of(plc.regions.begin(), plc.regions.end(),
                                                                  [](const plc::RegionSeed& r) { return r.max_volume > 0; });
+  if (use_collars) {
+    sliver.crease_vertex.assign(refined->normalised_positions.size(), 0);
+    for (uint32_t s = 0; s < complex->segments.size(); ++s) {
+      if (!complex->segments[s].crease) continue;
+      for (uint32_t p : refined->segment_chains[s]) sliver.crease_vertex[p] = 1;
+    }
+    for (uint32_t i = 0; i < complex->points.size(); ++i) {
+      if (complex->points[i].crease) sliver.crease_vertex[i] = 1;  // refiner point i = complex point i
+    }
+  }
   absl::StatusOr<refine::SliverResult> flipped = refine::RemoveSlivers(
       refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver);
   if (!flipped.ok()) return flipped.status();
@@ -236,8 +252,22 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                             " tets inverted by mapping Steiner points back to input coordinates"));
   }
   mesh::TetMesh mesh = std::move(out->mesh);
+  if (use_collars) {
+    // The collar stage is new and its conformity next to the creases is
+    // shown per input (docs/svrc-collars.md), not proven for every PLC:
+    // check it here and never return a mesh that does not conform.
+    report("check", mesh.positions.size(), 0, 0);
+    const mesh::ConformityReport check = mesh::CheckConformity(plc, mesh);
+    if (!check.ok()) {
+      return absl::FailedPreconditionError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
+                                                        " degrees): the stitched mesh next to the creases does not "
+                                                        "conform: ",
+                                                        check.Summary()));
+    }
+  }
   mesh.provenance.svrc_version = Version();
   mesh.provenance.parameters = absl::StrCat("mode=svrc radius_edge=", params.radius_edge, " theta=", params.theta,
+                                            use_collars ? absl::StrCat(" max_rep_angle=", params.max_rep_angle) : "",
                                             " keep_bounding_box=", params.keep_bounding_box ? 1 : 0);
   mesh.provenance.input_sha256 = plc.input_sha256;
   mesh.stats.Set("tets", static_cast<double>(mesh.tets.size()));

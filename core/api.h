@@ -20,8 +20,11 @@ struct MeshParams {
   double radius_edge = 2.0;
   // Warp radius factor [theta] (thesis §3.1.1).
   double theta = 0.9;
-  // Largest representation angle on the collar surface, degrees [sigma].
-  double max_rep_angle = 30.0;
+  // Largest representation angle on the collar surface, degrees [sigma]
+  // (thesis §3.1.2; the dihedral bound next to creases, docs/svrc-collars.md
+  // §1). 60, not the guide's 30: at 30 the COLLAR rounds do not settle yet
+  // (measured on two facets at 30°, docs/svrc-collars.md "Wiring status").
+  double max_rep_angle = 60.0;
   // Global max tet volume in input units³; <= 0: none.
   double max_volume = 0.0;
   // Sliver removal target in degrees (thesis §6.2.1); <= 0: off.

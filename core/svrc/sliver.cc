@@ -431,6 +431,11 @@ FlipMesh::Reject FlipMesh::NewTet(const Tet& t, double re_bound, double volume_b
   if (geom::Orient3d(pos_[t[0]], pos_[t[1]], pos_[t[2]], pos_[t[3]]) <= 0) return kOrientation;
   *q = Measure(pos_, t);
   if (!(q->radius_edge <= re_bound)) return kRadiusEdge;
+  if (!options_.crease_vertex.empty() && q->radius_edge > options_.max_radius_edge &&
+      !(options_.crease_vertex[t[0]] || options_.crease_vertex[t[1]] || options_.crease_vertex[t[2]] ||
+        options_.crease_vertex[t[3]])) {
+    return kRadiusEdge;
+  }
   if (options_.keep_max_volume && !(q->volume <= volume_bound)) return kVolume;
   return kOk;
 }

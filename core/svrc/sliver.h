@@ -40,6 +40,13 @@ struct SliverOptions {
   // largest ratio among the tets the flip replaces): the refiner's guarantee
   // (radius-edge ≤ τ/2) survives the pass. +inf: no bound.
   double max_radius_edge = 2.0;
+  // One flag per position (empty: none): crease vertices (thesis Theorem 4
+  // bounds radius-edge only for tets not touching a crease). When set, the
+  // relaxed bound above applies only to new tets with a crease vertex; a new
+  // tet without one must meet max_radius_edge itself (measured: flips next to
+  // RipStitchCollar's stars made tets away from the creases of crease_pair 30°
+  // reach radius-edge 7.8).
+  std::vector<uint8_t> crease_vertex;
   // No new tet may be larger (volume) than the largest input tet of its
   // component (the tets connected to it across non-constrained faces — the
   // labelling's components, docs/svrc-output.md §2). A flip never crosses a

@@ -68,7 +68,9 @@ TEST(MeshPlcPointSetTest, TooFewIndependentPointsIsInvalidArgument) {
   plc::Plc p;
   p.source_name = "flat.node";
   for (int i = 0; i < 10; ++i) p.vertices.emplace_back(i, 2 * i, 0);
-  auto m = MeshPlc(p, MeshParams{});
+  MeshParams capped;
+  capped.max_vertices = 3000;
+  auto m = MeshPlc(p, capped);
   ASSERT_FALSE(m.ok());
   EXPECT_EQ(m.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(m.status().message().find("flat.node"), std::string::npos) << m.status();
@@ -94,10 +96,11 @@ TEST(MeshPlcPointSetTest, ProgressAndCancel) {
 }
 
 // A PLC with facets goes to SVRC refinement, never to the point-set path. A
-// flat tetrahedron's facets meet at ~27° at its base: creases below 45°,
-// which need collars (issue #6), so it is refused up front with
-// FAILED_PRECONDITION naming the crease (milder creases are refined through,
-// tests/svrc/plc_refine_test.cc); a lone triangle encloses no volume:
+// flat tetrahedron's facets meet at ~27° at its base: creases below 45° go
+// through the collar stage (issue #6), which does not settle on this input
+// yet (COLLAR topology repairs at 1e-4 collar radii) and ends
+// FAILED_PRECONDITION naming the crease; a small vertex cap keeps the test
+// fast (6.5 s without it). A lone triangle encloses no volume:
 // INVALID_ARGUMENT.
 TEST(MeshPlcPointSetTest, PlcWithCreasesIsRefusedNamingTheCrease) {
   plc::Plc p;
@@ -107,7 +110,9 @@ TEST(MeshPlcPointSetTest, PlcWithCreasesIsRefusedNamingTheCrease) {
     f.polygons.push_back(plc::Polygon{{t[0], t[1], t[2]}});
     p.facets.push_back(f);
   }
-  auto m = MeshPlc(p, MeshParams{});
+  MeshParams capped;
+  capped.max_vertices = 3000;
+  auto m = MeshPlc(p, capped);
   ASSERT_FALSE(m.ok());
   EXPECT_EQ(m.status().code(), absl::StatusCode::kFailedPrecondition) << m.status();
   EXPECT_NE(m.status().message().find("crease"), std::string::npos) << m.status();

@@ -4,6 +4,8 @@
 // balls centred on different creases are disjoint (Lemma 13).
 #include <cmath>
 #include <map>
+#include <set>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -254,6 +256,27 @@ TEST(CollarRefineDebug, One) {
     ASSERT_TRUE(out.ok()) << out.status();
     const mesh::ConformityReport rep = mesh::CheckConformity(plc, out->mesh);
     const mesh::QualityReport q = mesh::ComputeQuality(out->mesh);
+    {
+      std::set<std::tuple<double, double, double>> crease_pos;
+      for (uint32_t s = 0; s < run.complex.segments.size(); ++s) {
+        if (!run.complex.segments[s].crease) continue;
+        for (uint32_t p : run.refined->segment_chains[s]) {
+          const geom::Vec3& x = run.refined->positions[p];
+          crease_pos.insert({x.x, x.y, x.z});
+        }
+      }
+      for (uint32_t i = 0; i < run.complex.points.size(); ++i) {
+        if (!run.complex.points[i].crease) continue;
+        const geom::Vec3& x = run.refined->positions[i];
+        crease_pos.insert({x.x, x.y, x.z});
+      }
+      std::vector<uint8_t> flag(out->mesh.positions.size());
+      for (size_t i = 0; i < flag.size(); ++i) {
+        const geom::Vec3& x = out->mesh.positions[i];
+        flag[i] = crease_pos.count({x.x, x.y, x.z}) ? 1 : 0;
+      }
+      std::printf("%s", mesh::FormatQualityReport(mesh::ComputeQuality(out->mesh, flag)).c_str());
+    }
     std::printf("stitched: %zu tets, checker %s: %s; min dihedral %.2f max dihedral %.2f max radius-edge %.3f\n",
                 out->mesh.tets.size(), rep.ok() ? "OK" : "FAIL", rep.Summary().c_str(), q.all.dihedral_deg.min,
                 q.all.dihedral_deg.max, q.all.radius_edge.max);
