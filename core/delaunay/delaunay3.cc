@@ -575,36 +575,52 @@ uint32_t Delaunay3::WalkStar(uint32_t v, uint32_t* num_neighbors) const {
   if (kNeighbors && vertex_bits_.size() * 64 < points_.size()) {
     vertex_bits_.resize(points_.size() / 64 + 1, 0);
   }
+  // Raw pointers and capacities in locals: the loop's stores cannot then
+  // make the compiler reload the vectors' internals.
   uint64_t* tbits = tet_bits_.data();
   uint64_t* vbits = vertex_bits_.data();
   const uint32_t* tets = tets_.data();
   TetId* star = star_buf_.data();
+  size_t star_cap = star_buf_.size();
+  VertexId* nbr = nbr_buf_.data();
+  TetId* nbr_tet = nbr_tet_buf_.data();
+  size_t nbr_cap = nbr_buf_.size();
   star[n++] = TetId(t0);
   tbits[t0 >> 6] |= uint64_t{1} << (t0 & 63);
   for (uint32_t k = 0; k < n; ++k) {
     const uint32_t t = star[k].value();
     const uint32_t* tv = &tets[8 * t];
     // Room for the (at most 3) tets and (at most 3) vertices this tet adds.
-    if (n + 3 > star_buf_.size()) {
-      star_buf_.resize(2 * star_buf_.size());
+    if (n + 3 > star_cap) [[unlikely]] {
+      star_buf_.resize(2 * star_cap);
       star = star_buf_.data();
+      star_cap = star_buf_.size();
     }
-    if (kNeighbors && m + 3 > nbr_buf_.size()) {
-      nbr_buf_.resize(2 * nbr_buf_.size());
+    if (kNeighbors && m + 3 > nbr_cap) [[unlikely]] {
+      nbr_buf_.resize(2 * nbr_cap);
       nbr_tet_buf_.resize(nbr_buf_.size());
+      nbr = nbr_buf_.data();
+      nbr_tet = nbr_tet_buf_.data();
+      nbr_cap = nbr_buf_.size();
     }
     for (int f = 0; f < 4; ++f) {
       const uint32_t w = tv[f];
       if (w == v) continue;  // the face opposite v does not contain v
-      if (kNeighbors && w != kInf && !(vbits[w >> 6] & (uint64_t{1} << (w & 63)))) {
-        vbits[w >> 6] |= uint64_t{1} << (w & 63);
-        nbr_buf_[m] = VertexId(w);
-        nbr_tet_buf_[m] = TetId(t);
-        ++m;
+      if (kNeighbors && w != kInf) {
+        uint64_t& word = vbits[w >> 6];
+        const uint64_t bit = uint64_t{1} << (w & 63);
+        if (!(word & bit)) {
+          word |= bit;
+          nbr[m] = VertexId(w);
+          nbr_tet[m] = TetId(t);
+          ++m;
+        }
       }
       const uint32_t u = tv[4 + f] >> 2;
-      if (!(tbits[u >> 6] & (uint64_t{1} << (u & 63)))) {
-        tbits[u >> 6] |= uint64_t{1} << (u & 63);
+      uint64_t& word = tbits[u >> 6];
+      const uint64_t bit = uint64_t{1} << (u & 63);
+      if (!(word & bit)) {
+        word |= bit;
         __builtin_prefetch(&tets[8 * u]);
         star[n++] = TetId(u);
       }
@@ -612,7 +628,7 @@ uint32_t Delaunay3::WalkStar(uint32_t v, uint32_t* num_neighbors) const {
   }
   for (uint32_t k = 0; k < n; ++k) tbits[star[k].value() >> 6] = 0;
   if (kNeighbors) {
-    for (uint32_t k = 0; k < m; ++k) vbits[nbr_buf_[k].value() >> 6] = 0;
+    for (uint32_t k = 0; k < m; ++k) vbits[nbr[k].value() >> 6] = 0;
   }
   if (num_neighbors != nullptr) *num_neighbors = m;
   return n;
