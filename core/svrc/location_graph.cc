@@ -52,15 +52,9 @@ inline LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) 
   if (mesh.value() < cell_spans_.size() && cell < cell_spans_[mesh.value()].size()) [[likely]] {
     return cell_spans_[mesh.value()][cell];
   }
-  if (cell_spans_.size() <= mesh.value()) {
-    cell_spans_.resize(mesh.value() + 1);
-    unresolved_.resize(mesh.value() + 1);
-  }
+  if (cell_spans_.size() <= mesh.value()) cell_spans_.resize(mesh.value() + 1);
   std::vector<Span>& spans = cell_spans_[mesh.value()];
-  if (spans.size() <= cell) {
-    spans.resize(cell + 1);
-    unresolved_[mesh.value()].resize(cell + 1, 0);
-  }
+  if (spans.size() <= cell) spans.resize(cell + 1);
   return spans[cell];
 }
 
@@ -120,16 +114,15 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
     return result;
   }
   const uint32_t l = NewLinkId();
-  cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved});
-  object_arena_.Append(os, ObjectEntry{mesh.value(), cell, l});
+  cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved, l});
+  object_arena_.Append(os, ObjectEntry{mesh.value(), cell});
   ++num_links_;
   ++stats_.links_added;
   result.link = LinkId(l);
 
   if (facts.unresolved) {
-    uint32_t& count = unresolved_[mesh.value()][cell];
-    result.cell_became_unresolved = (count == 0);
-    ++count;
+    result.cell_became_unresolved = (cs.unresolved == 0);
+    ++cs.unresolved;
   }
   // Figure 3.10: a ConfBall with the cell's vertex strictly inside is
   // encroached; native vertices trigger at once, others on the second,
@@ -143,8 +136,8 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   return result;
 }
 
-void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshId mesh, uint32_t cell) {
-  if (cell_arena_.Data(cs)[ci].unresolved) --unresolved_[mesh.value()][cell];
+void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi) {
+  if (cell_arena_.Data(cs)[ci].unresolved) --cs.unresolved;
   cell_arena_.Erase(cs, ci);
   object_arena_.Erase(os, oi);
   --num_links_;
@@ -153,17 +146,15 @@ void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshI
 
 void LocationGraph::RemoveLink(LinkId id) {
   if (!id.valid()) return;
-  for (int kind = 0; kind < 2; ++kind) {
-    const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
-    for (uint32_t o = 0; o < spans.size(); ++o) {
-      const ObjectEntry* e = object_arena_.Data(spans[o]);
-      for (uint32_t i = 0; i < spans[o].size; ++i) {
+  for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
+    for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
+      Span& cs = cell_spans_[m][c];
+      const CellEntry* e = cell_arena_.Data(cs);
+      for (uint32_t i = 0; i < cs.size; ++i) {
         if (e[i].link != id.value()) continue;
-        const LocationObject object{static_cast<ObjectKind>(kind), o};
-        const MeshId mesh(e[i].mesh);
-        const uint32_t cell = e[i].cell;
-        RemoveAt(cell_spans_[mesh.value()][cell], CellPos(cell_spans_[mesh.value()][cell], object),
-                 ObjectSpan(object), i, mesh, cell);
+        const LocationObject object = e[i].object();
+        Span& os = ObjectSpan(object);
+        RemoveAt(cs, i, os, ObjectPos(os, MeshId(m), c));
         return;
       }
     }
@@ -177,7 +168,7 @@ bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object
   const uint32_t oi = ObjectPos(*os, mesh, cell);
   if (oi == kNil) return false;
   const uint32_t ci = CellPos(*cs, object);
-  RemoveAt(cell_spans_[mesh.value()][cell], ci, ObjectSpan(object), oi, mesh, cell);
+  RemoveAt(cell_spans_[mesh.value()][cell], ci, ObjectSpan(object), oi);
   return true;
 }
 
@@ -187,15 +178,13 @@ void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<Loca
   // Front to back, as RemoveLink of each in turn would; the cell's array is
   // emptied at the end instead of shifting it once per link.
   const CellEntry* e = cell_arena_.Data(cs);
-  uint32_t unresolved = 0;
   for (uint32_t i = 0; i < cs.size; ++i) {
     const LocationObject object = e[i].object();
     if (removed != nullptr) removed->push_back(object);
-    if (e[i].unresolved) ++unresolved;
     Span& os = ObjectSpan(object);
     object_arena_.Erase(os, ObjectPos(os, mesh, cell));
   }
-  unresolved_[mesh.value()][cell] -= unresolved;
+  cs.unresolved = 0;
   num_links_ -= cs.size;
   stats_.links_removed += cs.size;
   cs.size = 0;
@@ -217,7 +206,7 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
     if (cells != nullptr) cells->push_back(oe.cell);
     Span& cs = cell_spans_[oe.mesh][oe.cell];
     const uint32_t ci = CellPos(cs, object);
-    if (cell_arena_.Data(cs)[ci].unresolved) --unresolved_[oe.mesh][oe.cell];
+    if (cell_arena_.Data(cs)[ci].unresolved) --cs.unresolved;
     cell_arena_.Erase(cs, ci);
     --num_links_;
     ++stats_.links_removed;
@@ -252,14 +241,15 @@ void LocationGraph::CellsOf(LocationObject object, MeshId mesh, std::vector<uint
 }
 
 uint32_t LocationGraph::NumUnresolved(MeshId mesh, uint32_t cell) const {
-  if (unresolved_.size() <= mesh.value() || unresolved_[mesh.value()].size() <= cell) return 0;
-  return unresolved_[mesh.value()][cell];
+  const Span* cs = FindCellSpan(mesh, cell);
+  return cs == nullptr ? 0 : cs->unresolved;
 }
 
 bool LocationGraph::Validate() const {
   // Cell side: each entry must have its partner (mesh, cell) in the object's
   // array. A duplicate object in a cell is caught from the object side.
   uint64_t count = 0;
+  std::vector<uint32_t> ids;
   for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
     for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
       const Span& cs = cell_spans_[m][c];
@@ -269,15 +259,16 @@ bool LocationGraph::Validate() const {
       for (uint32_t i = 0; i < cs.size; ++i) {
         const Span* os = FindObjectSpan(e[i].object());
         if (os == nullptr || ObjectPos(*os, MeshId(m), c) == kNil) return false;
+        if (e[i].link == LinkId::kNoneValue) return false;
+        ids.push_back(e[i].link);
         if (e[i].unresolved) ++unresolved;
         ++count;
       }
-      if (unresolved_[m][c] != unresolved) return false;
+      if (cs.unresolved != unresolved) return false;
     }
   }
   // Object side: no (mesh, cell) twice in an object's array, the cell's
-  // array holds the object exactly once, and every link id is distinct.
-  std::vector<uint32_t> ids;
+  // array holds the object exactly once; and every link id is distinct.
   uint64_t object_count = 0;
   for (int kind = 0; kind < 2; ++kind) {
     const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
@@ -287,8 +278,6 @@ bool LocationGraph::Validate() const {
       const LocationObject o{static_cast<ObjectKind>(kind), id};
       const ObjectEntry* e = object_arena_.Data(os);
       for (uint32_t i = 0; i < os.size; ++i) {
-        if (e[i].link == LinkId::kNoneValue) return false;
-        ids.push_back(e[i].link);
         for (uint32_t j = 0; j < i; ++j) {
           if (e[j].mesh == e[i].mesh && e[j].cell == e[i].cell) return false;
         }

@@ -5,13 +5,14 @@
 // links are added (AddLink) so the refiner can enqueue work events.
 //
 // Representation (guide §2 "BLG"; issue #5): contiguous arrays, not linked
-// lists. Per (mesh, cell) one array of {object, unresolved} entries, per object
-// one array of {mesh, cell, link} entries; each array is a block of a shared
+// lists. Per (mesh, cell) one array of {object, unresolved, link} entries, per
+// object one array of {mesh, cell} entries (8 bytes: the removal of a cell's
+// links scans its objects' arrays); each array is a block of a shared
 // arena (power-of-two capacities, recycled through per-size free lists). Adds
 // append at the end and removals shift the tail down by one, so iteration
 // order is the order of AddLink calls (deterministic; the refiner's output
 // depends on it). Each link gets a fresh LinkId from a counter, kept in its
-// object-side entry (no per-link record to write and free: the refiner never
+// cell-side entry (no per-link record to write and free: the refiner never
 // removes by LinkId; RemoveLink(LinkId) searches). A query walks one short
 // array (bounded ply, Lemma 6) instead of chasing one pointer per link.
 #pragma once
@@ -60,7 +61,7 @@ class LocationGraph {
   // (returns an invalid link): links are sets (Lemma 36 counts unique pairs).
   AddLinkResult AddLink(MeshId mesh, uint32_t cell, LocationObject object, const LinkFacts& facts,
                         BallStore* balls);
-  // RemoveLink: deletes both directions. Time linear in the number of links
+  // RemoveLink: deletes both directions. Time linear in the number of cells and links
   // (tests and debugging; the refiner removes by cell or object). An id
   // whose link is gone removes nothing (ids are not reused before 2^32 − 1
   // further links).
@@ -116,10 +117,13 @@ class LocationGraph {
   static constexpr uint32_t kNil = 0xFFFFFFFFu;
 
   // One block of an Arena: entries [offset, offset + size), room for `cap`.
+  // A cell's span also counts its unresolved links (next to its size: one
+  // access for both).
   struct Span {
     uint32_t offset = 0;
     uint32_t size = 0;
     uint32_t cap = 0;  // 0: no block yet; otherwise a power of two
+    uint32_t unresolved = 0;  // cell spans only
   };
   // Blocks of small arrays in one vector. A full block moves to a block of
   // twice its capacity (taken from that size's free list, else appended); the
@@ -143,19 +147,20 @@ class LocationGraph {
     std::vector<uint32_t> free_[32];  // [log2 cap] offsets of free blocks
   };
 
-  // The cell side: which object, and whether the link counts as unresolved.
+  // The cell side: which object, whether the link counts as unresolved, and
+  // the link's id.
   struct CellEntry {
     uint32_t object_id = 0;
     ObjectKind kind = ObjectKind::kBall;
     bool unresolved = false;
+    uint32_t link = 0;
     LocationObject object() const { return {kind, object_id}; }
     bool Is(LocationObject o) const { return object_id == o.id && kind == o.kind; }
   };
-  // The object side: which cell of which mesh, and the link's id.
+  // The object side: which cell of which mesh.
   struct ObjectEntry {
     uint32_t mesh = 0;
     uint32_t cell = 0;
-    uint32_t link = 0;
   };
 
   Span& CellSpan(MeshId mesh, uint32_t cell);
@@ -172,14 +177,13 @@ class LocationGraph {
   uint32_t NewLinkId();
   // Removes entry `oi` of the object's array and entry `ci` of the cell's
   // array, which must be the same link.
-  void RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi, MeshId mesh, uint32_t cell);
+  void RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi);
 
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;
   uint32_t next_link_ = 0;  // the next LinkId (skips kNone)
   uint32_t num_links_ = 0;
   std::vector<std::vector<Span>> cell_spans_;      // [mesh][cell]
-  std::vector<std::vector<uint32_t>> unresolved_;  // [mesh][cell]
   std::vector<Span> ball_spans_;
   std::vector<Span> collar_spans_;
   Stats stats_;
