@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <memory>
 #include <utility>
 
 #include "absl/status/status.h"
@@ -229,22 +228,8 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
     };
     for (size_t t = 0; t < nt; ++t) for_faces(t, [&](const FaceRec& r) { ++bucket[r.a + 1]; });
     for (size_t v = 0; v < nv; ++v) bucket[v + 1] += bucket[v];
-    // The scatter by a in two stable passes, so that writes go to few places
-    // at a time (one pass straight to ~nv places is a cache miss per face):
-    // first to at most 256 groups of consecutive a (a group's records land
-    // where its vertices' buckets are), then each group, small enough to
-    // stay in cache, to its buckets. Stable passes keep slot order per a.
-    int shift = 0;
-    while (nv > 0 && ((nv - 1) >> shift) >= 256) ++shift;
-    const size_t groups = nv == 0 ? 0 : ((nv - 1) >> shift) + 1;
-    const auto grouped = std::make_unique_for_overwrite<FaceRec[]>(4 * nt);
-    std::vector<uint32_t> gfill(groups);
-    for (size_t g = 0; g < groups; ++g) gfill[g] = bucket[g << shift];
-    for (size_t t = 0; t < nt; ++t) {
-      for_faces(t, [&](const FaceRec& r) { grouped[gfill[r.a >> shift]++] = r; });
-    }
     std::vector<uint32_t> fill(bucket.begin(), bucket.end() - 1);
-    for (size_t i = 0; i < 4 * nt; ++i) faces[fill[grouped[i].a]++] = grouped[i];
+    for (size_t t = 0; t < nt; ++t) for_faces(t, [&](const FaceRec& r) { faces[fill[r.a]++] = r; });
   }
   // Match equal faces inside each bucket (no sort): a face (a, b, c) finds
   // the earlier ones with the same b through a per-b chain (head stamped
