@@ -13,6 +13,8 @@
 //   family:NAME, --family NAME   one generated family (--list shows the names)
 //   families, --families  every generated family (families::StandardInputs)
 //   --radius-edge 2,1.414 bounds to run (svrc --radius-edge B, tetgen -pq<B>)
+//   --max-volume V        a global max volume (svrc --max-volume V, tetgen -a<V>)
+//                         for the FILE inputs after it (0: none again)
 //   --tools svrc,tetgen   which peers run
 //   --timeout 120         seconds per run (then SIGKILL: "timeout")
 //   --mem-limit-mib 4096  RLIMIT_AS of each child (a run past it fails)
@@ -523,7 +525,7 @@ int Usage(const char* argv0) {
                "usage: %s [--radius-edge 2,1.414] [--tools svrc,tetgen] [--timeout 120] "
                "[--mem-limit-mib 4096] [--svrc PATH] [--tetgen PATH] [--workdir DIR] [--keep] "
                "[--list] INPUT...\n  INPUT: a PLC file, family:NAME (--family NAME), "
-               "families (--families)\n",
+               "families (--families); --max-volume V applies to the files after it\n",
                argv0);
   return 2;
 }
@@ -548,6 +550,8 @@ int Main(int argc, char** argv) {
       specs.push_back("family:" + value());
     } else if (a == "--radius-edge") {
       o.bounds = ParseList(value());
+    } else if (a == "--max-volume") {
+      specs.push_back("maxvol:" + value());
     } else if (a == "--tools") {
       const std::string t = value();
       o.run_svrc = t.find("svrc") != std::string::npos;
@@ -586,8 +590,15 @@ int Main(int argc, char** argv) {
 
   std::vector<Input> inputs;
   std::vector<GeneratedInput> generated = plc::families::StandardInputs();
+  double file_max_volume = 0;  // --max-volume: for the file inputs after it
   for (const std::string& spec : specs) {
-    if (spec == "families") {
+    if (spec.rfind("maxvol:", 0) == 0) {
+      file_max_volume = std::atof(spec.c_str() + 7);
+      if (!(file_max_volume >= 0)) {
+        std::fprintf(stderr, "bad --max-volume %s\n", spec.c_str() + 7);
+        return 2;
+      }
+    } else if (spec == "families") {
       for (const GeneratedInput& g : generated) {
         inputs.push_back(Input{g.name, {}, g.plc, g.max_volume});
       }
@@ -606,7 +617,9 @@ int Main(int argc, char** argv) {
         std::fprintf(stderr, "cannot read %s: %s\n", spec.c_str(), plc.status().ToString().c_str());
         return 1;
       }
-      inputs.push_back(Input{Label(spec), fs::absolute(spec), *std::move(plc), 0});
+      const std::string label =
+          file_max_volume > 0 ? absl::StrCat(Label(spec), " (max volume ", file_max_volume, ")") : Label(spec);
+      inputs.push_back(Input{label, fs::absolute(spec), *std::move(plc), file_max_volume});
     }
   }
   if (inputs.empty()) return Usage(argv[0]);
