@@ -29,18 +29,20 @@ void TriangleCircumball(const Vec3& a, const Vec3& b, const Vec3& c, Vec3* cente
 BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureId feature,
                       MeshId mesh, Cd cd, int n, std::array<PointId, 3> verts) {
   const BallId id(size());
-  center_.push_back(center);
-  radius_.push_back(radius);
-  kind_.push_back(kind);
-  feature_.push_back(feature);
+  Record r;
+  r.center = center;
+  r.radius = radius;
+  r.verts = verts;
+  r.generation = 0;
+  r.first_encroacher = kNonePoint;
+  r.feature = feature;
+  r.cd = cd;
+  r.num_verts = static_cast<uint8_t>(n);
+  r.alive = 1;
+  r.kind = kind;
+  r.encroach_queued = 0;
+  rec_.push_back(r);
   mesh_.push_back(mesh);
-  cd_.push_back(cd);
-  num_verts_.push_back(static_cast<uint8_t>(n));
-  verts_.push_back(verts);
-  alive_.push_back(1);
-  generation_.push_back(0);
-  first_encroacher_.push_back(kNonePoint);
-  encroach_queued_.push_back(0);
   ++num_alive_;
   return id;
 }
@@ -64,15 +66,16 @@ BallId BallStore::AddTriangleBall(PointId a, PointId b, PointId c, const Vec3& c
 }
 
 void BallStore::Kill(BallId b) {
-  if (!alive_[b.value()]) return;
-  alive_[b.value()] = 0;
-  ++generation_[b.value()];
+  Record& r = rec_[b.value()];
+  if (!r.alive) return;
+  r.alive = 0;
+  ++r.generation;
   --num_alive_;
 }
 
 EncroachOutcome BallStore::RecordEncroacher(BallId b, PointId v, bool native) {
   if (native) return EncroachOutcome::kEnqueue;
-  PointId& first = first_encroacher_[b.value()];
+  PointId& first = rec_[b.value()].first_encroacher;
   if (!first.valid()) {
     first = v;
     return EncroachOutcome::kPartial;

@@ -48,23 +48,23 @@ class BallStore {
   BallId AddTriangleBall(PointId a, PointId b, PointId c, const geom::Vec3& center, double radius,
                          FeatureId feature, MeshId mesh);
 
-  uint32_t size() const { return static_cast<uint32_t>(center_.size()); }
+  uint32_t size() const { return static_cast<uint32_t>(rec_.size()); }
   uint32_t NumAlive() const { return num_alive_; }
 
-  const geom::Vec3& Center(BallId b) const { return center_[b.value()]; }
-  double Radius(BallId b) const { return radius_[b.value()]; }
-  BallKind Kind(BallId b) const { return kind_[b.value()]; }
-  FeatureId Feature(BallId b) const { return feature_[b.value()]; }
+  const geom::Vec3& Center(BallId b) const { return rec_[b.value()].center; }
+  double Radius(BallId b) const { return rec_[b.value()].radius; }
+  BallKind Kind(BallId b) const { return rec_[b.value()].kind; }
+  FeatureId Feature(BallId b) const { return rec_[b.value()].feature; }
   MeshId Mesh(BallId b) const { return mesh_[b.value()]; }
-  Cd CdOf(BallId b) const { return cd_[b.value()]; }  // CD of the centre (Def 36)
+  Cd CdOf(BallId b) const { return rec_[b.value()].cd; }  // CD of the centre (Def 36)
   // The dual simplex: 1 (vertex ball), 2 (piece) or 3 (triangle) global points.
-  int NumVertices(BallId b) const { return num_verts_[b.value()]; }
-  PointId Vertex(BallId b, int i) const { return verts_[b.value()][i]; }
-  bool IsVertexBall(BallId b) const { return num_verts_[b.value()] == 1; }
-  PointId VertexPoint(BallId b) const { return verts_[b.value()][0]; }
+  int NumVertices(BallId b) const { return rec_[b.value()].num_verts; }
+  PointId Vertex(BallId b, int i) const { return rec_[b.value()].verts[i]; }
+  bool IsVertexBall(BallId b) const { return rec_[b.value()].num_verts == 1; }
+  PointId VertexPoint(BallId b) const { return rec_[b.value()].verts[0]; }
 
-  bool IsAlive(BallId b) const { return alive_[b.value()] != 0; }
-  uint32_t Generation(BallId b) const { return generation_[b.value()]; }
+  bool IsAlive(BallId b) const { return rec_[b.value()].alive != 0; }
+  uint32_t Generation(BallId b) const { return rec_[b.value()].generation; }
   // The ball's dual simplex left its mesh (or the ball was destroyed): dead for
   // good, generation bumped so queued events and links can tell.
   void Kill(BallId b);
@@ -74,28 +74,35 @@ class BallStore {
   // triggers on the second *different* encroacher; re-linking the same vertex
   // after its cell changed must not count twice (guide §7).
   EncroachOutcome RecordEncroacher(BallId b, PointId v, bool native);
-  PointId FirstEncroacher(BallId b) const { return first_encroacher_[b.value()]; }
+  PointId FirstEncroacher(BallId b) const { return rec_[b.value()].first_encroacher; }
 
   // An Encroached event for b is pending (avoids duplicate events).
-  bool EncroachQueued(BallId b) const { return encroach_queued_[b.value()] != 0; }
-  void SetEncroachQueued(BallId b, bool q) { encroach_queued_[b.value()] = q ? 1 : 0; }
+  bool EncroachQueued(BallId b) const { return rec_[b.value()].encroach_queued != 0; }
+  void SetEncroachQueued(BallId b, bool q) { rec_[b.value()].encroach_queued = q ? 1 : 0; }
 
  private:
   BallId Add(BallKind kind, const geom::Vec3& center, double radius, FeatureId feature, MeshId mesh,
              Cd cd, int n, std::array<PointId, 3> verts);
 
-  std::vector<geom::Vec3> center_;
-  std::vector<double> radius_;
-  std::vector<BallKind> kind_;
-  std::vector<FeatureId> feature_;
-  std::vector<MeshId> mesh_;
-  std::vector<Cd> cd_;
-  std::vector<uint8_t> num_verts_;
-  std::vector<std::array<PointId, 3>> verts_;
-  std::vector<uint8_t> alive_;
-  std::vector<uint32_t> generation_;
-  std::vector<PointId> first_encroacher_;
-  std::vector<uint8_t> encroach_queued_;
+  // One cache line per ball (issue #5): Destroy and UpdateLocation read a
+  // ball's centre, radius, CD, vertices and liveness together for balls in
+  // random id order; as twelve parallel arrays that was one miss per field.
+  struct alignas(64) Record {
+    geom::Vec3 center;
+    double radius = 0;
+    std::array<PointId, 3> verts;
+    uint32_t generation = 0;
+    PointId first_encroacher;
+    FeatureId feature;
+    Cd cd;
+    uint8_t num_verts = 0;
+    uint8_t alive = 0;
+    BallKind kind = BallKind::kConf;
+    uint8_t encroach_queued = 0;
+  };
+  static_assert(sizeof(Record) == 64);
+  std::vector<Record> rec_;
+  std::vector<MeshId> mesh_;  // rarely read
   uint32_t num_alive_ = 0;
 };
 
