@@ -110,8 +110,6 @@ class Refiner {
   absl::StatusOr<bool> SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume);
   void CountSizeRound() { ++stats_.size_rounds; }
  private:
-  // The sorted point-id faces and edges of M_Ω's finite tets.
-  void OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces, std::vector<std::array<uint32_t, 2>>* edges) const;
   // End of the queues: a piece that is not an edge of M_Ω or of a facet mesh
   // containing it, or an in-facet triangle that is not a face of M_Ω, has a
   // non-encroached but tied ball (vertices exactly on its sphere on several
@@ -164,13 +162,11 @@ class Refiner {
     if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
     out->clear();
     for (Cell u : cells) {
-      balls_scratch_.clear();
-      blg_.BallsOf(mesh, u.value(), &balls_scratch_);
-      for (BallId b : balls_scratch_) {
-        if (ball_mark_[b.value()] == ball_stamp_) continue;
+      blg_.ForEachBall(mesh, u.value(), [&](BallId b) {
+        if (ball_mark_[b.value()] == ball_stamp_) return;
         ball_mark_[b.value()] = ball_stamp_;
         out->push_back(b);
-      }
+      });
     }
   }
 
@@ -202,6 +198,37 @@ class Refiner {
   bool FeatureContains(FeatureId f, PointId p) const;
   // The facets containing crease point p (an input point or a point of a
   // segment), ascending: the complex's incidence lists, no search.
+  // Facets whose feature contains p, sorted (none for a point of Ω).
+  void FacetsOfPoint(PointId p, std::vector<uint32_t>* out) const {
+    out->clear();
+    const FeatureId parent = points_.Parent(p);
+    if (parent == FeatureTable::Omega()) return;
+    if (features_.Dim(parent) == 2) {
+      out->push_back(features_.Index(parent));
+      return;
+    }
+    const std::span<const uint32_t> th = FacetsThrough(p);
+    out->assign(th.begin(), th.end());
+    std::sort(out->begin(), out->end());
+  }
+  // The facet a triangle of points lies on: the first facet containing its
+  // three points whose region contains its centroid, or kNoFacet.
+  uint32_t FacetOfTriangle(const std::array<PointId, 3>& k, std::vector<uint32_t>* fa,
+                           std::vector<uint32_t>* fb) const {
+    FacetsOfPoint(k[0], fa);
+    for (int j = 1; j < 3 && !fa->empty(); ++j) {
+      FacetsOfPoint(k[j], fb);
+      std::vector<uint32_t> both;
+      std::set_intersection(fa->begin(), fa->end(), fb->begin(), fb->end(), std::back_inserter(both));
+      fa->swap(both);
+    }
+    for (uint32_t f : *fa) {
+      const Vec2 a = Uv(f, k[0]), b = Uv(f, k[1]), c = Uv(f, k[2]);
+      const Vec2 g{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3};
+      if (facets_[f].region().Locate(g) != FacetRegion::Where::kOutside) return f;
+    }
+    return kNoFacet;
+  }
   std::span<const uint32_t> FacetsThrough(PointId p) const {
     const FeatureId parent = points_.Parent(p);
     if (features_.Dim(parent) == 0) return point_facets_[features_.Index(parent)];
@@ -391,7 +418,7 @@ class Refiner {
   uint32_t stamp_ = 0;
   std::vector<uint32_t> ball_mark_;
   uint32_t ball_stamp_ = 0;
-  std::vector<BallId> balls_scratch_, gathered_;
+  std::vector<BallId> gathered_;
   std::vector<LocationObject> objects_;
 };
 
@@ -1123,8 +1150,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
       // there from a neighbouring cell whose exact cell kept it (so v's cell
       // did not change and its event came back). The gap ball is then not
       // empty: nothing to destroy.
-      const VertexId near = omega_.dt().NearestVertex(c, s.hint);
-      if (omega_.dt().Point(near) == c) {
+      if (omega_.dt().VertexAt(c, s.hint).valid()) {
         ++stats_.phantom_corners;
         return absl::OkStatus();
       }
@@ -1897,31 +1923,6 @@ absl::Status Refiner::CheckInvariants(bool final) {
   return absl::OkStatus();
 }
 
-void Refiner::OmegaSimplices(std::vector<std::array<uint32_t, 3>>* faces_out,
-                             std::vector<std::array<uint32_t, 2>>* edges_out) const {
-  const delaunay::Delaunay3& dt = omega_.dt();
-  auto& faces = *faces_out;
-  auto& edges = *edges_out;
-  faces.clear();
-  edges.clear();
-  for (TetId t : dt.FiniteTets()) {
-    std::array<uint32_t, 4> v;
-    for (int k = 0; k < 4; ++k) v[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
-    std::sort(v.begin(), v.end());
-    faces.push_back({v[0], v[1], v[2]});
-    faces.push_back({v[0], v[1], v[3]});
-    faces.push_back({v[0], v[2], v[3]});
-    faces.push_back({v[1], v[2], v[3]});
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i + 1; j < 4; ++j) edges.push_back({v[i], v[j]});
-    }
-  }
-  std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-}
-
 absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume) {
   const delaunay::Delaunay3& dt = omega_.dt();
   const uint32_t nv = dt.NumVertices();
@@ -2164,16 +2165,13 @@ bool Refiner::EnqueueMissing() {
 }
 
 absl::Status Refiner::VerifyConformity() const {
-  std::vector<std::array<uint32_t, 3>> faces;
-  std::vector<std::array<uint32_t, 2>> edges;
-  OmegaSimplices(&faces, &edges);
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
     const SegmentMesh& m = segs_[sg];
     for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
       std::array<uint32_t, 2> e{m.PointOf(v).value(), m.PointOf(m.Next(v)).value()};
       std::sort(e.begin(), e.end());
       if (options_.collars && InsideCollars(std::array<PointId, 2>{PointId(e[0]), PointId(e[1])})) continue;
-      if (!std::binary_search(edges.begin(), edges.end(), e)) {
+      if (!OmegaHasEdge(PointId(e[0]), PointId(e[1]))) {
         return absl::InternalError(absl::StrCat("SVRC: piece (", e[0], ", ", e[1], ") of segment ", sg,
                                                 " is not an edge of M_Ω"));
       }
@@ -2186,7 +2184,7 @@ absl::Status Refiner::VerifyConformity() const {
       if (options_.collars && InsideCollars(std::array<PointId, 3>{PointId(k[0]), PointId(k[1]), PointId(k[2])})) {
         continue;
       }
-      if (!std::binary_search(faces.begin(), faces.end(), k)) {
+      if (!OmegaHasFace(PointId(k[0]), PointId(k[1]), PointId(k[2]))) {
         return absl::InternalError(absl::StrCat("SVRC: in-facet triangle (", k[0], ", ", k[1], ", ", k[2],
                                                 ") of facet ", f, " is not a face of M_Ω"));
       }
@@ -2285,33 +2283,10 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     std::sort(faces.begin(), faces.end());
     faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
     out.facet_triangles.assign(facets_.size(), {});
-    std::vector<uint32_t> cand, next;
-    auto facets_of = [&](PointId p, std::vector<uint32_t>* fs) {
-      fs->clear();
-      const FeatureId parent = points_.Parent(p);
-      if (parent == FeatureTable::Omega()) return;
-      if (features_.Dim(parent) == 2) {
-        fs->push_back(features_.Index(parent));
-      } else {
-        const std::span<const uint32_t> th = FacetsThrough(p);
-        fs->assign(th.begin(), th.end());
-        std::sort(fs->begin(), fs->end());
-      }
-    };
+    std::vector<uint32_t> fa, fb;
     for (const auto& k : faces) {
-      facets_of(PointId(k[0]), &cand);
-      for (int j = 1; j < 3 && !cand.empty(); ++j) {
-        facets_of(PointId(k[j]), &next);
-        std::vector<uint32_t> both;
-        std::set_intersection(cand.begin(), cand.end(), next.begin(), next.end(), std::back_inserter(both));
-        cand.swap(both);
-      }
-      for (uint32_t f : cand) {
-        const Vec2 a = Uv(f, PointId(k[0])), b = Uv(f, PointId(k[1])), c = Uv(f, PointId(k[2]));
-        const Vec2 g{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3};
-        if (facets_[f].region().Locate(g) == FacetRegion::Where::kOutside) continue;
-        out.facet_triangles[f].push_back(k);
-      }
+      const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
+      if (f != kNoFacet) out.facet_triangles[f].push_back(k);
     }
   }
   RefineStats& st = stats_;
