@@ -191,18 +191,6 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   const std::string crease = FirstCrease(*complex, &sharpest);
   constexpr double kCollarAngleDeg = 45;
   const bool use_collars = !crease.empty() && sharpest < kCollarAngleDeg;
-  if (use_collars && (params.max_volume > 0 || std::any_of(plc.regions.begin(), plc.regions.end(), [](const plc::RegionSeed& r) {
-                         return r.max_volume > 0;
-                       }))) {
-    // The size rounds label M_Ω before RipStitchCollar has sealed the facets
-    // inside the collars; their flood leaks (measured on knife_edge.poly with
-    // --max-volume 1e-3: "no tetrahedron is left", and with the collars walled
-    // off, tets of 2.6e-3 left in the block's corners). Refuse rather than
-    // return a mesh that misses the bound.
-    return absl::UnimplementedError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
-                                                 " degrees): max_volume together with creases below ",
-                                                 kCollarAngleDeg, " degrees is not supported yet"));
-  }
   if (use_collars) {
     options.collars = true;
     options.collar_surface = true;
@@ -275,6 +263,24 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                                         " degrees): the stitched mesh next to the creases does not "
                                                         "conform: ",
                                                         check.Summary()));
+    }
+    // max_volume inside the collars: the stitched stars and books are not
+    // refined by size events (the points inside are removed), so a collar
+    // larger than the bound leaves tets above it; refuse rather than return
+    // them.
+    for (size_t t = 0; t < mesh.tets.size(); ++t) {
+      const auto& v = mesh.tets[t];
+      const geom::Vec3 a = mesh.positions[v[0]];
+      const double vol =
+          geom::Dot(mesh.positions[v[1]] - a, geom::Cross(mesh.positions[v[2]] - a, mesh.positions[v[3]] - a)) / 6;
+      double bound = params.max_volume > 0 ? params.max_volume : HUGE_VAL;
+      const int32_t r = mesh.tet_region.empty() ? -1 : mesh.tet_region[t];
+      if (r >= 0 && mesh.regions[r].max_volume > 0) bound = std::min(bound, mesh.regions[r].max_volume);
+      if (vol > bound * (1 + 1e-9)) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "SVRC: ", crease, " (sharpest ", sharpest, " degrees): a tet of volume ", vol,
+            " next to the creases exceeds max_volume ", bound, " (collar tets are not refined by size yet)"));
+      }
     }
   }
   mesh.provenance.svrc_version = Version();

@@ -250,6 +250,10 @@ class Refiner {
   absl::StatusOr<bool> CollarRound() { return CollarRoundImpl(); }
   // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
   absl::Status Stitch() { return StitchImpl(); }
+  void ClearStitch() {
+    stitched_done_ = false;
+    stitched_.clear();
+  }
   // After a stitch: edges of the final tets near the collars that cross a
   // facet through a collar's centre at a point outside every ball get that
   // point as a facet Steiner point (CD (2,3)); returns how many went in. The
@@ -1929,12 +1933,43 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   std::vector<Vec3> positions(nv);
   for (uint32_t v = 0; v < nv; ++v) positions[v] = dt.Point(VertexId(v));
   std::vector<std::array<uint32_t, 4>> tets;
-  for (TetId t : dt.FiniteTets()) {
-    tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
-                    dt.TetVertex(t, 3).value()});
-  }
   std::vector<ConstrainedFace> faces;
-  for (uint32_t f = 0; f < facets_.size(); ++f) {
+  if (stitched_done_) {
+    // After RipStitchCollar (collars): label the stitched mesh, whose facets
+    // are sealed, with its faces on the facets (as Output() takes them).
+    // M_Ω before the stitch leaks through the collars (measured on
+    // knife_edge.poly --max-volume 1e-3: "no tetrahedron is left").
+    for (const auto& t : stitched_) {
+      std::array<uint32_t, 4> tv;
+      for (int k = 0; k < 4; ++k) tv[k] = points_.VertexIn(PointId(t[k]), kOmegaMesh);
+      tets.push_back(tv);
+    }
+    std::vector<std::array<uint32_t, 3>> tris;
+    for (const auto& t : stitched_) {
+      for (int k = 0; k < 4; ++k) {
+        std::array<uint32_t, 3> fc{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
+        std::sort(fc.begin(), fc.end());
+        tris.push_back(fc);
+      }
+    }
+    std::sort(tris.begin(), tris.end());
+    tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
+    std::vector<uint32_t> fa, fb;
+    for (const auto& k : tris) {
+      const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
+      if (f == kNoFacet) continue;
+      ConstrainedFace cf;
+      for (int j = 0; j < 3; ++j) cf.v[j] = points_.VertexIn(PointId(k[j]), kOmegaMesh);
+      cf.facet = f;
+      faces.push_back(cf);
+    }
+  } else {
+    for (TetId t : dt.FiniteTets()) {
+      tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
+                      dt.TetVertex(t, 3).value()});
+    }
+  }
+  for (uint32_t f = 0; f < facets_.size() && !stitched_done_; ++f) {
     for (const auto& tri : facets_[f].InFacetTriangles()) {
       ConstrainedFace cf;
       for (int k = 0; k < 3; ++k) cf.v[k] = points_.VertexIn(tri[k], kOmegaMesh);
@@ -2440,9 +2475,12 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   for (const plc::RegionSeed& sd : complex.regions) any_volume = any_volume || sd.max_volume > 0;
   // The rounds label M_Ω by flooding across non-facet faces, which leaks
   // through the collars until RipStitchCollar rebuilds them: stage (d) alone
-  // applies no max_volume (measured: example.poly flooded to "no tet left").
+  // applies no max_volume (measured: example.poly flooded to "no tet left"),
+  // and with the collar surface the size rounds run after the stitch, on the
+  // stitched mesh's labelling (below).
   if (options.collars && !options.collar_surface) any_volume = false;
-  for (int round = 0; any_volume && round < 64; ++round) {
+  const bool sizes_after_stitch = any_volume && options.collars && options.collar_surface && refiner.collars().size() > 0;
+  for (int round = 0; any_volume && !sizes_after_stitch && round < 64; ++round) {
     absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
     if (!more.ok()) return more.status();
     if (!*more) break;
@@ -2462,6 +2500,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
     s = refiner.Run();
     if (!s.ok()) return s;
   }
+  int crossing_passes = 0, size_passes = 0;
   for (int stitch_pass = 0;; ++stitch_pass) {
   if (options.collars && options.collar_surface) {
     // COLLAR events, then RipStitchCollar (Figure 3.2's last line).
@@ -2503,11 +2542,27 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
     std::fprintf(stderr, "stitch pass %d: %u facet crossings outside the collars\n", stitch_pass, *crossings);
   }
-  if (*crossings == 0) break;
-  if (stitch_pass == 7) {
-    return absl::ResourceExhaustedError(absl::StrCat("SVRC: the stitched mesh still crosses the facets next to the "
-                                                     "collars after 8 passes (", *crossings, " crossings left)"));
+  if (*crossings > 0) {
+    if (++crossing_passes == 8) {
+      return absl::ResourceExhaustedError(absl::StrCat("SVRC: the stitched mesh still crosses the facets next to "
+                                                       "the collars after 8 passes (", *crossings, " crossings left)"));
+    }
+    s = refiner.Run();
+    if (!s.ok()) return s;
+    continue;
   }
+  if (!sizes_after_stitch) break;
+  // Size events on the stitched mesh's labelling; new points, then the
+  // rounds and the stitch again. Converges like the rounds above (targets
+  // carry over); 64 passes at most.
+  absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
+  if (!more.ok()) return more.status();
+  if (!*more) break;
+  if (++size_passes == 64) {
+    return absl::ResourceExhaustedError("SVRC: max_volume next to the collars did not settle in 64 passes");
+  }
+  refiner.CountSizeRound();
+  refiner.ClearStitch();
   s = refiner.Run();
   if (!s.ok()) return s;
   }
