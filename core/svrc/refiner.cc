@@ -409,6 +409,7 @@ class Refiner {
   CollarSurfaceReport surface_report_;
   uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, crossing_count_ = 0;
   std::vector<std::pair<uint32_t, Vec2>> crossing_repairs_;  // (facet, uv) of this round
+  uint32_t centre_repairs_ = 0;  // points on S cutting a crease vertex's cell back inside its collar
  private:
   RefineStats stats_;
   uint64_t budget_ = 0;
@@ -1319,6 +1320,13 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
                             points_.CdOf(p).collar, " and ", points_.CdOf(q).dim, ",", points_.CdOf(q).collar,
                             ", parents ", points_.Parent(p).value(), " and ", points_.Parent(q).value(), ")");
     }
+    // With collars, a facet refined next to a crease down to the resolution
+    // of doubles (two gap-ball centres rounding to one point; measured on
+    // wedge-1.smesh, 1°) is a limit of this implementation, not a bug.
+    if (options_.collars && r.outcome == delaunay::Delaunay2::InsertOutcome::kDuplicate) {
+      return absl::FailedPreconditionError(absl::StrCat("SVRC: facet mesh ", f, " was refined to the resolution of ",
+                                                        "doubles next to a crease", detail));
+    }
     return absl::InternalError(
         absl::StrCat("SVRC: point ", p.value(), " could not be inserted into facet mesh ", f, detail));
   }
@@ -1585,6 +1593,43 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   copt.sigma = options_.max_rep_angle;
   surface_report_ = CollarSurfaceReport();
   std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_);
+  // A crease vertex must be strictly inside the stitched hole (Figure 3.12:
+  // its star replaces the inside): every tet around it needs its
+  // circumcentre inside the collars. A tet whose circumcentre is outside
+  // means the centre's Voronoi cell crosses S there; the point of the
+  // centre's sphere towards that circumcentre goes in (CD (3,2)), which cuts
+  // the cell back (measured: segment_fan.poly's stitch refused 8 crease
+  // vertices on hole-boundary faces).
+  {
+    const delaunay::Delaunay3& d = omega_.dt();
+    std::vector<TetId> star;
+    for (uint32_t i = 0; i < collars_.size(); ++i) {
+      const PointId c = collar_centre_[i];
+      if (!points_.InMesh(c, kOmegaMesh)) continue;
+      const VertexId v(points_.VertexIn(c, kOmegaMesh));
+      const CollarBall& ball = collars_.ball(i);
+      d.Star(v, &star);
+      for (TetId t : star) {
+        if (d.IsGhost(t)) continue;
+        const Vec3 cc = d.Circumcenter(t);
+        if (collars_.StrictlyInside(cc)) continue;
+        const Vec3 dir = cc - ball.center;
+        const double len = geom::Norm(dir);
+        if (!(len > 0)) continue;
+        CollarRepair r;
+        r.x = ball.center + (ball.radius / len) * dir;
+        r.ball = i;
+        r.collar_dim = 2;
+        r.reason = CollarRepair::kTopology;
+        if (collars_.FindContaining(r.x) != CollarIndex::kNone) continue;  // not on S
+        const VertexId nv = d.NearestVertex(r.x, t);
+        r.radius = geom::Dist(r.x, d.Point(nv));
+        if (!(r.radius > 0)) continue;
+        reps.push_back(r);
+        ++centre_repairs_;
+      }
+    }
+  }
   // Largest RepBall first (Figure 3.11's buckets), ties by position.
   std::stable_sort(reps.begin(), reps.end(), [](const CollarRepair& a, const CollarRepair& b) { return a.radius > b.radius; });
   bool any = false;
@@ -2513,10 +2558,10 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
       if (!more.ok()) return more.status();
       if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
         const CollarSurfaceReport& r = refiner.surface_report_;
-        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u crossings %u\n",
+        std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u crossings %u centres %u\n",
                      round, r.repairs[0], r.repairs[1], r.repairs[2], r.repairs[3], r.bad_roots, r.bad_facets, r.bad_links,
                      r.bad_sphere_links, r.empty_spheres, r.bad_circles, r.bad_boundaries, r.bad_angles,
-                     refiner.collar_repairs_, refiner.arc_repairs_, refiner.crossing_count_);
+                     refiner.collar_repairs_, refiner.arc_repairs_, refiner.crossing_count_, refiner.centre_repairs_);
       }
       if (!*more) {
         settled = true;

@@ -150,7 +150,12 @@ TEST(CreaseMesh, CorpusInputsThatMesh) {
   // knife_edge.poly broke the sliver pass until RipStitchCollar's removed
   // crease points were dropped from the segment chains.
   // example.poly's sharpest crease is 63°: refined through without collars.
-  for (const char* f : {"c_creases/knife_edge.poly", "c_creases/knife_edge.obj", "b_internal/example.poly"}) {
+  // segment_fan.poly's stitch refused 8 crease vertices on hole-boundary
+  // faces until COLLAR repairs cut the centres' cells back inside their
+  // balls; the same repairs let schonhardt.off settle (it ran into the
+  // RepBall floor before).
+  for (const char* f : {"c_creases/knife_edge.poly", "c_creases/knife_edge.obj", "b_internal/example.poly",
+                        "d_small_angles/segment_fan.poly", "c_creases/schonhardt.off"}) {
     absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(f));
     ASSERT_TRUE(plc.ok()) << f << ": " << plc.status();
     MeshAndCheck(*plc, f);
@@ -164,7 +169,7 @@ TEST(CreaseMesh, UnfinishedInputsFailNamingTheCrease) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
 #endif
-  for (const char* f : {"c_creases/schonhardt.off", "c_creases/wedge-1.smesh", "d_small_angles/segment_fan.poly"}) {
+  for (const char* f : {"c_creases/wedge-1.smesh"}) {
     absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(f));
     ASSERT_TRUE(plc.ok()) << f << ": " << plc.status();
     absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(*plc, {});
