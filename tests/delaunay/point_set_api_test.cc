@@ -98,7 +98,7 @@ TEST(MeshPlcPointSetTest, ProgressAndCancel) {
 // A PLC with facets goes to SVRC refinement, never to the point-set path. A
 // flat tetrahedron's facets meet at ~27° at its base: creases below 45° go
 // through the collar stage (issue #6), which does not settle on this input
-// yet (COLLAR topology repairs at 1e-4 collar radii) and ends
+// yet (a COLLAR repair below 1e-4 collar radii, docs/svrc-collars.md) and ends
 // FAILED_PRECONDITION naming the crease; a small vertex cap keeps the test
 // fast (6.5 s without it). A lone triangle encloses no volume:
 // INVALID_ARGUMENT.
