@@ -196,8 +196,6 @@ class Refiner {
   double FeatureDistance(FeatureId f, PointId p, const Vec3& x) const;
   // Does feature f contain point p (an input point or a segment point)?
   bool FeatureContains(FeatureId f, PointId p) const;
-  // The facets containing crease point p (an input point or a point of a
-  // segment), ascending: the complex's incidence lists, no search.
   // Facets whose feature contains p, sorted (none for a point of Ω).
   void FacetsOfPoint(PointId p, std::vector<uint32_t>* out) const {
     out->clear();
@@ -229,6 +227,11 @@ class Refiner {
     }
     return kNoFacet;
   }
+  // The faces of the stitched tets lying on a facet (FacetOfTriangle), as
+  // (facet, sorted point ids), in ascending face order.
+  std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> StitchedFacetFaces() const;
+  // The facets containing crease point p (an input point or a point of a
+  // segment), ascending: the complex's incidence lists, no search.
   std::span<const uint32_t> FacetsThrough(PointId p) const {
     const FeatureId parent = points_.Parent(p);
     if (features_.Dim(parent) == 0) return point_facets_[features_.Index(parent)];
@@ -408,7 +411,6 @@ class Refiner {
   StitchResult stitch_report_;
   CollarSurfaceReport surface_report_;
   uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, crossing_count_ = 0;
-  std::vector<std::pair<uint32_t, Vec2>> crossing_repairs_;  // (facet, uv) of this round
   uint32_t centre_repairs_ = 0;  // points on S cutting a crease vertex's cell back inside its collar
  private:
   RefineStats stats_;
@@ -1583,6 +1585,15 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   return absl::OkStatus();
 }
 
+// Segment pa–pb crosses the plane of frame fr, its ends strictly on opposite
+// sides beyond tol; *x = the crossing.
+bool CrossesPlane(const plc::FacetFrame& fr, const Vec3& pa, const Vec3& pb, double tol, Vec3* x) {
+  const double ha = geom::Dot(pa - fr.origin, fr.normal), hb = geom::Dot(pb - fr.origin, fr.normal);
+  if (!((ha > tol && hb < -tol) || (ha < -tol && hb > tol))) return false;
+  *x = pa + (ha / (ha - hb)) * (pb - pa);
+  return true;
+}
+
 // Smallest RepBall accepted, relative to its collar ball's radius.
 constexpr double kMinCollarRepairRatio = 1e-4;
 
@@ -1634,7 +1645,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   std::stable_sort(reps.begin(), reps.end(), [](const CollarRepair& a, const CollarRepair& b) { return a.radius > b.radius; });
   bool any = false;
   const delaunay::Delaunay3& dt = omega_.dt();
-  crossing_repairs_.clear();
+  std::vector<std::pair<uint32_t, Vec2>> crossings;  // (facet, arc point uv) of this round
   if (reps.empty()) {
     const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt);
     // Facet-crossing check: RipStitchCollar's fan (centre, a, b) covers a
@@ -1650,10 +1661,8 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
         for (int k = 0; k < 3; ++k) {
           const Vec3& pa = dt.Point(t.v[k]);
           const Vec3& pb = dt.Point(t.v[(k + 1) % 3]);
-          const double ha = geom::Dot(pa - fr.origin, fr.normal), hb = geom::Dot(pb - fr.origin, fr.normal);
-          const double tol = 1e-12 * ball.radius;
-          if (!((ha > tol && hb < -tol) || (ha < -tol && hb > tol))) continue;
-          const Vec3 x = pa + (ha / (ha - hb)) * (pb - pa);
+          Vec3 x;
+          if (!CrossesPlane(fr, pa, pb, 1e-12 * ball.radius, &x)) continue;
           const Vec2 uv = fr.ToPlane(x), cuv = fr.ToPlane(ball.center);
           const double hc = geom::Dot(ball.center - fr.origin, fr.normal);
           const double rp2 = ball.radius * ball.radius - hc * hc;
@@ -1662,7 +1671,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
           if (!(d > 0)) continue;
           const Vec2 q{cuv.x + std::sqrt(rp2) * dx / d, cuv.y + std::sqrt(rp2) * dy / d};
           if (facets_[f].region().Locate(q) == FacetRegion::Where::kOutside) continue;
-          crossing_repairs_.push_back({f, q});
+          crossings.push_back({f, q});
         }
       }
     }
@@ -1724,7 +1733,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     std::stable_sort(ar.begin(), ar.end(), [](const ArcRepair& a, const ArcRepair& b) {
       return a.collar_dim < b.collar_dim || (a.collar_dim == b.collar_dim && a.radius > b.radius);
     });
-    for (const auto& [cf, q] : crossing_repairs_) {
+    for (const auto& [cf, q] : crossings) {
       // All of a round's crossings go in together, next to its arc repairs
       // (measured: one facet crossing per round left crease_pair 1° unsettled
       // after 256 rounds with 227 crossings; together, 1° settles and
@@ -1760,6 +1769,26 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   return any;
 }
 
+std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacetFaces() const {
+  std::vector<std::array<uint32_t, 3>> faces;
+  for (const auto& t : stitched_) {
+    for (int k = 0; k < 4; ++k) {
+      std::array<uint32_t, 3> fc{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
+      std::sort(fc.begin(), fc.end());
+      faces.push_back(fc);
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> out;
+  std::vector<uint32_t> fa, fb;
+  for (const auto& k : faces) {
+    const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
+    if (f != kNoFacet) out.emplace_back(f, k);
+  }
+  return out;
+}
+
 absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
   // M_Ω conforms to a facet F outside the collars through F's triangles, but
   // not where a triangle of M_F has a corner suppressed inside a collar (M_Ω
@@ -1789,10 +1818,8 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
         for (int b = a + 1; b < 4; ++b) {
           const Vec3& pa = points_.Xyz(PointId(t[a]));
           const Vec3& pb = points_.Xyz(PointId(t[b]));
-          const double ha = geom::Dot(pa - fr.origin, fr.normal), hb = geom::Dot(pb - fr.origin, fr.normal);
-          const double tol = 1e-12 * collars_.ball(bi).radius;
-          if (!((ha > tol && hb < -tol) || (ha < -tol && hb > tol))) continue;
-          const Vec3 x = pa + (ha / (ha - hb)) * (pb - pa);
+          Vec3 x;
+          if (!CrossesPlane(fr, pa, pb, 1e-12 * collars_.ball(bi).radius, &x)) continue;
           if (collars_.StrictlyInside(x)) continue;
           const Vec2 uv = fr.ToPlane(x);
           if (facets_[f].region().Locate(uv) != FacetRegion::Where::kInside) continue;
@@ -1816,10 +1843,7 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
     if (!st.ok()) return st;
     ++inserted;
   }
-  if (inserted > 0) {
-    stitched_done_ = false;
-    stitched_.clear();
-  }
+  if (inserted > 0) ClearStitch();
   return inserted;
 }
 
@@ -1993,20 +2017,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       for (int k = 0; k < 4; ++k) tv[k] = points_.VertexIn(PointId(t[k]), kOmegaMesh);
       tets.push_back(tv);
     }
-    std::vector<std::array<uint32_t, 3>> tris;
-    for (const auto& t : stitched_) {
-      for (int k = 0; k < 4; ++k) {
-        std::array<uint32_t, 3> fc{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
-        std::sort(fc.begin(), fc.end());
-        tris.push_back(fc);
-      }
-    }
-    std::sort(tris.begin(), tris.end());
-    tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
-    std::vector<uint32_t> fa, fb;
-    for (const auto& k : tris) {
-      const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
-      if (f == kNoFacet) continue;
+    for (const auto& [f, k] : StitchedFacetFaces()) {
       ConstrainedFace cf;
       for (int j = 0; j < 3; ++j) cf.v[j] = points_.VertexIn(PointId(k[j]), kOmegaMesh);
       cf.facet = f;
@@ -2017,18 +2028,19 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
                       dt.TetVertex(t, 3).value()});
     }
-  }
-  for (uint32_t f = 0; f < facets_.size() && !stitched_done_; ++f) {
-    for (const auto& tri : facets_[f].InFacetTriangles()) {
-      ConstrainedFace cf;
-      for (int k = 0; k < 3; ++k) cf.v[k] = points_.VertexIn(tri[k], kOmegaMesh);
-      // Inside collars a facet point may be suppressed (never in M_Ω): its
-      // triangles are not faces of M_Ω (RipStitchCollar rebuilds them).
-      if (cf.v[0] == PointStore::kNoVertex || cf.v[1] == PointStore::kNoVertex || cf.v[2] == PointStore::kNoVertex) {
-        continue;
+    for (uint32_t f = 0; f < facets_.size(); ++f) {
+      for (const auto& tri : facets_[f].InFacetTriangles()) {
+        ConstrainedFace cf;
+        for (int k = 0; k < 3; ++k) cf.v[k] = points_.VertexIn(tri[k], kOmegaMesh);
+        // Inside collars a facet point may be suppressed (never in M_Ω): its
+        // triangles are not faces of M_Ω (RipStitchCollar rebuilds them).
+        if (cf.v[0] == PointStore::kNoVertex || cf.v[1] == PointStore::kNoVertex ||
+            cf.v[2] == PointStore::kNoVertex) {
+          continue;
+        }
+        cf.facet = f;
+        faces.push_back(cf);
       }
-      cf.facet = f;
-      faces.push_back(cf);
     }
   }
   std::vector<plc::RegionSeed> seeds = complex.regions;
@@ -2356,22 +2368,8 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     // (a triangle with its corners on a non-convex outline can span a notch or
     // a hole). Outside the collars these are exactly M_F's triangles (the
     // conformity of §3.2.2); inside, the stitched fans (Theorem 4's proof).
-    std::vector<std::array<uint32_t, 3>> faces;
-    for (const auto& t : stitched_) {
-      for (int k = 0; k < 4; ++k) {
-        std::array<uint32_t, 3> fc{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
-        std::sort(fc.begin(), fc.end());
-        faces.push_back(fc);
-      }
-    }
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
     out.facet_triangles.assign(facets_.size(), {});
-    std::vector<uint32_t> fa, fb;
-    for (const auto& k : faces) {
-      const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
-      if (f != kNoFacet) out.facet_triangles[f].push_back(k);
-    }
+    for (const auto& [f, k] : StitchedFacetFaces()) out.facet_triangles[f].push_back(k);
   }
   RefineStats& st = stats_;
   st.vertices = dt.NumVertices();

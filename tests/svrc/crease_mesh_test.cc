@@ -111,10 +111,6 @@ TEST(CreaseMesh, FacetPair5) {
   MeshAndCheck(plc::families::CreaseFacetPair(5), "crease_pair_5");
 }
 
-// max_volume with collars: the size rounds run after the stitch on the
-// stitched mesh's labelling. Before the stitch the flood leaked through the
-// unsealed collars (knife_edge.poly --max-volume 1e-3 ended INVALID_ARGUMENT
-// "no tetrahedron is left ... an open surface?", blaming the input).
 // 1°: did not settle in 256 COLLAR rounds while facet crossings went in one
 // per round (227 after 256 rounds); with a round's crossings inserted
 // together it settles and conforms (~890,000 tets, ~75 s, 660 MB release).
@@ -125,6 +121,10 @@ TEST(CreaseMesh, FacetPair1) {
   MeshAndCheck(plc::families::CreaseFacetPair(1), "crease_pair_1");
 }
 
+// max_volume with collars: the size rounds run after the stitch on the
+// stitched mesh's labelling. Before the stitch the flood leaked through the
+// unsealed collars (knife_edge.poly --max-volume 1e-3 ended INVALID_ARGUMENT
+// "no tetrahedron is left ... an open surface?", blaming the input).
 TEST(CreaseMesh, KnifeEdgeWithMaxVolume) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
