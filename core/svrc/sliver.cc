@@ -13,7 +13,6 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/geometry/predicates.h"
-#include "core/mesh/quality.h"
 
 namespace svrc::refine {
 namespace {
@@ -58,8 +57,8 @@ struct Quality {
 
 Quality Measure(std::span<const Vec3> pos, Tet t) {
   std::sort(t.begin(), t.end());
-  const mesh::TetQuality q = mesh::ComputeTetQuality(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]);
-  return Quality{q.min_dihedral_deg, q.max_dihedral_deg, q.radius_edge, std::fabs(q.volume)};
+  const SliverTetQuality q = MeasureSliverTet(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]);
+  return Quality{q.min_dihedral_deg, q.max_dihedral_deg, q.radius_edge, q.volume};
 }
 
 // Edge removal (Shewchuk, "Two discrete optimization algorithms for the
@@ -933,6 +932,66 @@ std::vector<Tet> FlipMesh::Output() const {
 }
 
 }  // namespace
+
+SliverTetQuality MeasureSliverTet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  // The expressions of mesh::ComputeTetQuality (core/mesh/quality.cc), in the
+  // same order (-ffp-contract=off: the same roundings), so every value is the
+  // same double; the pass's stats and the output's quality report agree.
+  static constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  static constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+  const Vec3 p[4] = {a, b, c, d};
+  SliverTetQuality q;
+  double shortest2 = kInf;
+  for (const auto& e : kEdge) shortest2 = std::min(shortest2, geom::Dist2(p[e[0]], p[e[1]]));
+  const Vec3 u = b - a, v = c - a, w = d - a;
+  const double det = geom::Dot(u, geom::Cross(v, w));
+  q.volume = std::fabs(det / 6);
+  if (det != 0 && shortest2 > 0) {
+    const Vec3 num = geom::Norm2(u) * geom::Cross(v, w) + geom::Norm2(v) * geom::Cross(w, u) +
+                     geom::Norm2(w) * geom::Cross(u, v);
+    q.radius_edge = geom::Norm(num) / (2 * std::fabs(det)) / std::sqrt(shortest2);
+  } else {
+    q.radius_edge = kInf;
+  }
+  // Dihedral angle at edge k: atan2(y_k, x_k) with y_k = |n1 × n2| >= 0 and
+  // x_k = n1 · n2. Only the smallest and the largest are wanted, and atan2
+  // is most of the cost. P(y, x) = y / (x + y) for x >= 0, 1 + |x| / (|x| + y)
+  // for x < 0, is a pseudo-angle: increasing in the angle θ of (x, y) on
+  // [0, π], with dP/dθ = 1 / (|cos θ| + sin θ)² <= 1, so θ_k − θ_j >= P_k − P_j.
+  // Computed, it is off by at most ~4.4e-16 (two roundings relative to
+  // values <= 1, one addition); std::atan2 is within 1 ulp (<= 4.4e-16 on
+  // [0, π]). So an edge with P_k > P_min + 1e-12 has θ_k > θ_min + 9.9e-13
+  // and its atan2 value exceeds the one at P's minimum: it cannot be the
+  // smallest angle (likewise for the largest). The angles of the remaining
+  // candidates are computed as before, and min/max over them is the min/max
+  // over all six. A pair with a NaN or infinite P (y = x = 0: a degenerate
+  // face) takes the plain loop.
+  double ys[6], xs[6], ps[6];
+  bool finite = true;
+  double pmin = kInf, pmax = -kInf;
+  for (int k = 0; k < 6; ++k) {
+    const Vec3& pi = p[kEdge[k][0]];
+    const Vec3 e = p[kEdge[k][1]] - pi;
+    const Vec3 n1 = geom::Cross(e, p[kEdge[5 - k][0]] - pi);
+    const Vec3 n2 = geom::Cross(e, p[kEdge[5 - k][1]] - pi);
+    ys[k] = geom::Norm(geom::Cross(n1, n2));
+    xs[k] = geom::Dot(n1, n2);
+    ps[k] = xs[k] >= 0 ? ys[k] / (xs[k] + ys[k]) : 1 + (-xs[k]) / (ys[k] - xs[k]);
+    finite = finite && std::isfinite(ps[k]);
+    pmin = std::min(pmin, ps[k]);
+    pmax = std::max(pmax, ps[k]);
+  }
+  constexpr double kMargin = 1e-12;
+  q.min_dihedral_deg = kInf;
+  q.max_dihedral_deg = 0;
+  for (int k = 0; k < 6; ++k) {
+    if (finite && ps[k] > pmin + kMargin && ps[k] < pmax - kMargin) continue;
+    const double angle = std::atan2(ys[k], xs[k]) * kRadToDeg;
+    q.min_dihedral_deg = std::min(q.min_dihedral_deg, angle);
+    q.max_dihedral_deg = std::max(q.max_dihedral_deg, angle);
+  }
+  return q;
+}
 
 void SliverStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("sliver.tets_before", static_cast<double>(tets_before));

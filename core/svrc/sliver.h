@@ -72,6 +72,23 @@ struct SliverOptions {
   uint64_t max_flips = 0;
 };
 
+// The quality the pass ranks tets by: the smallest and largest dihedral
+// angle (degrees), the radius-edge ratio and |volume| of tet abcd, equal bit
+// for bit to those fields of mesh::ComputeTetQuality(a, b, c, d) (volume: its
+// absolute value) — the same expressions, without the aspect ratio, and with
+// std::atan2 evaluated only for the edges whose angle can be the smallest or
+// the largest: a monotone pseudo-angle of each edge's (sin, cos) pair rules
+// out the others with a margin far above the rounding of either function
+// (sliver.cc). Exposed for the equality test.
+struct SliverTetQuality {
+  double min_dihedral_deg = 0;
+  double max_dihedral_deg = 0;
+  double radius_edge = 0;
+  double volume = 0;
+};
+SliverTetQuality MeasureSliverTet(const geom::Vec3& a, const geom::Vec3& b, const geom::Vec3& c,
+                                  const geom::Vec3& d);
+
 // Statistics of one run (exported as "sliver.*" counters).
 struct SliverStats {
   uint64_t tets_before = 0, tets_after = 0;

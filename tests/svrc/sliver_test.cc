@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <random>
@@ -430,6 +431,59 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
     sequences += s.lookahead_sequences;
   }
   EXPECT_GT(sequences, 0u);  // the depth-2 search was exercised (and kept every invariant above)
+}
+
+
+// The pass's own quality evaluation skips atan2 for edges that cannot hold
+// the smallest or largest dihedral angle; every field must still be the same
+// double as mesh::ComputeTetQuality's (outputs and stats depend on it). Tets
+// of every shape: random, slivers (four points near a circle, lifted off its
+// plane by 1e-3 .. 1e-15), needles, caps, exactly flat ones, regular-ish ones
+// with ties between angles, and edge lengths over many scales.
+TEST(Sliver, MeasureMatchesComputeTetQuality) {
+  std::mt19937_64 rng(20261121);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  auto bits = [](double x) { return std::bit_cast<uint64_t>(x); };
+  auto check = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+    const mesh::TetQuality ref = mesh::ComputeTetQuality(a, b, c, d);
+    const SliverTetQuality q = MeasureSliverTet(a, b, c, d);
+    ASSERT_EQ(bits(q.min_dihedral_deg), bits(ref.min_dihedral_deg)) << q.min_dihedral_deg << " " << ref.min_dihedral_deg;
+    ASSERT_EQ(bits(q.max_dihedral_deg), bits(ref.max_dihedral_deg)) << q.max_dihedral_deg << " " << ref.max_dihedral_deg;
+    ASSERT_EQ(bits(q.radius_edge), bits(ref.radius_edge));
+    ASSERT_EQ(bits(q.volume), bits(std::fabs(ref.volume)));
+  };
+  auto rnd = [&] { return Vec3{unit(rng), unit(rng), unit(rng)}; };
+  for (int i = 0; i < 20000; ++i) {
+    ASSERT_NO_FATAL_FAILURE(check(rnd(), rnd(), rnd(), rnd()));
+    // A sliver: four points on a circle, lifted alternately.
+    const double h = std::pow(10.0, -3 - static_cast<int>(rng() % 13));
+    Vec3 s[4];
+    for (int k = 0; k < 4; ++k) {
+      const double t = 2 * M_PI * (k + 0.1 * unit(rng)) / 4;
+      s[k] = Vec3{std::cos(t), std::sin(t), (k % 2 ? h : -h) * (1 + 0.5 * unit(rng))};
+    }
+    ASSERT_NO_FATAL_FAILURE(check(s[0], s[1], s[2], s[3]));
+    ASSERT_NO_FATAL_FAILURE(check(s[0], s[2], s[1], s[3]));
+    // A needle and a cap.
+    const double e = std::pow(10.0, -1 - static_cast<int>(rng() % 10));
+    ASSERT_NO_FATAL_FAILURE(check(Vec3{0, 0, 0}, Vec3{1, e * unit(rng), 0}, Vec3{1 + e * unit(rng), 0, e},
+                                  Vec3{2, e * unit(rng), e * unit(rng)}));
+    ASSERT_NO_FATAL_FAILURE(check(Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0.5, 0.8, 0}, Vec3{0.5, 0.3, e * unit(rng)}));
+    // Scaled and translated.
+    const double sc = std::pow(2.0, static_cast<int>(rng() % 60) - 30);
+    const Vec3 off = rnd();
+    ASSERT_NO_FATAL_FAILURE(check(off + sc * rnd(), off + sc * rnd(), off + sc * rnd(), off + sc * rnd()));
+  }
+  // Exactly flat, with a degenerate (collinear) face, a regular tet (six
+  // equal angles), a cube-corner tet (ties), an integer grid.
+  ASSERT_NO_FATAL_FAILURE(check(Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{1, 1, 0}));
+  ASSERT_NO_FATAL_FAILURE(check(Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{2, 0, 0}, Vec3{0, 1, 1}));
+  ASSERT_NO_FATAL_FAILURE(check(Vec3{1, 1, 1}, Vec3{1, -1, -1}, Vec3{-1, 1, -1}, Vec3{-1, -1, 1}));
+  ASSERT_NO_FATAL_FAILURE(check(Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}));
+  for (int i = 0; i < 20000; ++i) {
+    auto g = [&] { return Vec3{static_cast<double>(rng() % 4), static_cast<double>(rng() % 4), static_cast<double>(rng() % 4)}; };
+    ASSERT_NO_FATAL_FAILURE(check(g(), g(), g(), g()));
+  }
 }
 
 }  // namespace
