@@ -50,9 +50,26 @@ bool InDisk(Vec2 p, const PlaneCircle& c) {
 
 // Rounding floor for "on the circle": a constructed point is off by a few ulps
 // of its coordinates.
-double OnCircleTolerance(const PlaneCircle& c, double snap) {
+// Distance below which two points computed on circle c are one point up to
+// the rounding of its centre and radius.
+double RoundingTolerance(const PlaneCircle& c) {
   const double scale = std::max(std::fabs(c.center.x), std::fabs(c.center.y)) + c.radius;
-  return std::max(snap * c.radius, 64 * kU * scale);
+  return 64 * kU * scale;
+}
+
+double OnCircleTolerance(const PlaneCircle& c, double snap) {
+  return std::max(snap * c.radius, RoundingTolerance(c));
+}
+
+// p is (2,1) point k up to rounding. A point computed elsewhere as a
+// crossing of a circle, e.g. an earlier round's arc repair on the bisector of
+// two crease vertices that both carry a collar ball by now, can miss the
+// (2,1) point's own rounding by 1e-17; two such vertices next to each other
+// were refined down to the resolution of doubles (wedge-1.smesh).
+bool At21(const FacetCollarSystem& sys, uint32_t k, Vec2 p) {
+  const Point21& q = sys.points21[k];
+  if (q.x == p) return true;
+  return Len(q.x - p) <= RoundingTolerance(sys.circles[q.circle_a]);
 }
 
 // Arc parameter of a point p on (or near) the circle of arc `a`, clamped to
@@ -61,8 +78,8 @@ double OnCircleTolerance(const PlaneCircle& c, double snap) {
 double ArcParam(const FacetCollarSystem& sys, uint32_t a, Vec2 p) {
   const CollarArc& arc = sys.arcs[a];
   if (!arc.full) {
-    if (arc.end[0] != kNoArcIndex && sys.points21[arc.end[0]].x == p) return 0;
-    if (arc.end[1] != kNoArcIndex && sys.points21[arc.end[1]].x == p) return arc.length;
+    if (arc.end[0] != kNoArcIndex && At21(sys, arc.end[0], p)) return 0;
+    if (arc.end[1] != kNoArcIndex && At21(sys, arc.end[1], p)) return arc.length;
   }
   const PlaneCircle& c = sys.circles[arc.circle];
   const double phi = std::atan2(p.y - c.center.y, p.x - c.center.x);
@@ -235,7 +252,7 @@ bool OnArc(Vec2 p, const FacetCollarSystem& system, uint32_t a, const ArcOptions
   const CollarArc& arc = system.arcs[a];
   if (!arc.full) {
     for (uint32_t e : arc.end) {
-      if (e != kNoArcIndex && system.points21[e].x == p) return true;
+      if (e != kNoArcIndex && At21(system, e, p)) return true;
     }
   }
   const PlaneCircle& c = system.circles[arc.circle];
@@ -403,7 +420,7 @@ std::vector<ArcRepair> ArcRepairs(const Delaunay2& dt, const FacetCollarSystem& 
     const Point21& p = system.points21[k];
     VertexId2 v;
     bool outside = false;
-    if (VertexAt(dt, p.x, &v, &outside)) {
+    if (VertexAt(dt, p.x, &v, &outside) || (!outside && At21(system, k, dt.Point(v)))) {
       p21_vertex[k] = v;
       p21_present[k] = true;
       continue;
@@ -612,6 +629,29 @@ std::vector<ArcRepair> ArcRepairs(const Delaunay2& dt, const FacetCollarSystem& 
     r.collar_dim = 2;
     r.radius = e.rep_radius;
     r.reason = static_cast<ArcRepairReason>(reason[i]);
+    // A crossing at an end of its arc, up to rounding, is that end's (2,1)
+    // point. Two collar balls of one radius on neighbouring crease vertices
+    // meet on their bisector, which is the Voronoi edge of the two centres,
+    // so this is the rule, not the exception. Inserted as a (2,2) point
+    // 1e-17 beside the (2,1) point, it left two vertices a rounding error
+    // apart and the next facet refinement split them down to the resolution
+    // of doubles (measured on wedge-1.smesh: 19 such pairs on one facet).
+    const CollarArc& arc = system.arcs[e.arc];
+    uint32_t at_end = kNoArcIndex;
+    for (int k = 0; k < 2 && !arc.full; ++k) {
+      if (arc.end[k] != kNoArcIndex && At21(system, arc.end[k], r.x)) at_end = arc.end[k];
+    }
+    if (at_end != kNoArcIndex) {
+      if (p21_present[at_end]) continue;  // already a vertex: nothing to insert
+      const Point21& p = system.points21[at_end];
+      r.x = p.x;
+      r.ball = std::min(p.a, p.b);
+      r.other_ball = std::max(p.a, p.b);
+      r.arc = kNoArcIndex;
+      r.point21 = at_end;
+      r.collar_dim = 1;
+      r.radius = 0;
+    }
     emit(r);
   }
   if (report != nullptr) *report = rep;
@@ -644,8 +684,8 @@ std::vector<ArcChain> ArcChains(const Delaunay2& dt, const FacetCollarSystem& sy
       ok = n >= 3;
     } else {
       ok = n >= 2 && arc.end[0] != kNoArcIndex && arc.end[1] != kNoArcIndex &&
-           dt.Point(chain.vertices.front()) == system.points21[arc.end[0]].x &&
-           dt.Point(chain.vertices.back()) == system.points21[arc.end[1]].x;
+           At21(system, arc.end[0], dt.Point(chain.vertices.front())) &&
+           At21(system, arc.end[1], dt.Point(chain.vertices.back()));
     }
     for (size_t i = 0; ok && i + 1 < n; ++i) {
       ok = Adjacent(dt, chain.vertices[i], chain.vertices[i + 1], &scratch);

@@ -726,45 +726,42 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     }
     if (ok) continue;
     ++rep.bad_circles;
-    // Biggest gap between consecutive rep points (or arc ends) along the
-    // circle; no rep point on a whole circle: the farthest of 8 points from
-    // its nearest vertex.
-    double best_t = 0, best_gap = -1;
+    // The gaps between consecutive rep points (or arc ends) along the circle
+    // (no rep point on a whole circle: 8 probes); the repair is the gap
+    // midpoint farthest from its nearest vertex, i.e. the largest RepBall.
+    // Not simply the longest gap: a vertex on the circle whose Voronoi cell
+    // is flanked by a collar centre's (equidistant from the whole circle)
+    // has its two crossings symmetric about it, so the longest gap's midpoint
+    // was that vertex up to rounding and the repair came back every round
+    // (measured: a flat tetrahedron, 27° creases, stopped at the RepBall floor
+    // with a circle repair 2.8e-17 from vertex 2955).
+    std::vector<double> probes;
     if (res.circle_state[k] == 1 && params.empty()) {
-      double best_d = -1;
-      for (int s = 0; s < 8; ++s) {
-        const double t = kTwoPi * s / 8;
-        const Vec3 x = CirclePoint(circle, t);
-        const double d = geom::Dist(x, dt.Point(dt.NearestVertex(x)));
-        if (d > best_d) {
-          best_d = d;
-          best_t = t;
-        }
-      }
+      for (int s = 0; s < 8; ++s) probes.push_back(kTwoPi * s / 8);
     } else if (res.circle_state[k] == 1) {
       for (size_t i = 0; i < params.size(); ++i) {
         const double a = params[i];
         const double b = i + 1 < params.size() ? params[i + 1] : params[0] + kTwoPi;
-        if (b - a > best_gap) {
-          best_gap = b - a;
-          best_t = 0.5 * (a + b);
-        }
+        probes.push_back(std::fmod(0.5 * (a + b), kTwoPi));
       }
     } else {
       for (const Arc& arc : res.circle_arcs[k]) {
         double a = arc.t0;
         for (double t : params) {
           if (t < arc.t0 || t > arc.t1) continue;
-          if (t - a > best_gap) {
-            best_gap = t - a;
-            best_t = 0.5 * (a + t);
-          }
+          probes.push_back(0.5 * (a + t));
           a = t;
         }
-        if (arc.t1 - a > best_gap) {
-          best_gap = arc.t1 - a;
-          best_t = 0.5 * (a + arc.t1);
-        }
+        probes.push_back(0.5 * (a + arc.t1));
+      }
+    }
+    double best_t = 0, best_d = -1;
+    for (double t : probes) {
+      const Vec3 x = CirclePoint(circle, std::fmod(t, kTwoPi));
+      const double d = geom::Dist(x, dt.Point(dt.NearestVertex(x)));
+      if (d > best_d) {
+        best_d = d;
+        best_t = t;
       }
     }
     add(CirclePoint(circle, std::fmod(best_t, kTwoPi)), collars.circles[k].a, k,

@@ -1594,6 +1594,9 @@ bool CrossesPlane(const plc::FacetFrame& fr, const Vec3& pa, const Vec3& pb, dou
   return true;
 }
 
+// CollarRepair::Reason in error messages.
+constexpr const char* kCollarRepairName[] = {"topology", "angle", "circle", "size"};
+
 // Smallest RepBall accepted, relative to its collar ball's radius.
 constexpr double kMinCollarRepairRatio = 1e-4;
 
@@ -1684,7 +1687,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     const double ball_r = collars_.ball(r.ball).radius;
     if (r.radius < kMinCollarRepairRatio * ball_r) {
       return absl::FailedPreconditionError(absl::StrCat(
-          "SVRC: COLLAR ", r.reason == CollarRepair::kTopology ? "topology" : "angle", " repair at (", r.x.x, ", ",
+          "SVRC: COLLAR ", kCollarRepairName[r.reason], " repair at (", r.x.x, ", ",
           r.x.y, ", ", r.x.z, ") needs a point ", r.radius / ball_r, " collar radii from the nearest vertex; the ",
           "collar surface sampling does not settle (ball ", r.ball, ", radius ", ball_r, ")"));
     }
