@@ -603,27 +603,29 @@ uint32_t Delaunay3::WalkStar(uint32_t v, uint32_t* num_neighbors) const {
       nbr_tet = nbr_tet_buf_.data();
       nbr_cap = nbr_buf_.size();
     }
+    // Branch-free appends: whether a tet or vertex is new is data-dependent
+    // (a star tet is reached over three faces, once first), so the entry is
+    // always written at the end and the count moves on only when it was new.
     for (int f = 0; f < 4; ++f) {
       const uint32_t w = tv[f];
       if (w == v) continue;  // the face opposite v does not contain v
       if (kNeighbors && w != kInf) {
         uint64_t& word = vbits[w >> 6];
         const uint64_t bit = uint64_t{1} << (w & 63);
-        if (!(word & bit)) {
-          word |= bit;
-          nbr[m] = VertexId(w);
-          nbr_tet[m] = TetId(t);
-          ++m;
-        }
+        const uint32_t fresh = (word & bit) == 0;
+        word |= bit;
+        nbr[m] = VertexId(w);
+        nbr_tet[m] = TetId(t);
+        m += fresh;
       }
       const uint32_t u = tv[4 + f] >> 2;
       uint64_t& word = tbits[u >> 6];
       const uint64_t bit = uint64_t{1} << (u & 63);
-      if (!(word & bit)) {
-        word |= bit;
-        __builtin_prefetch(&tets[8 * u]);
-        star[n++] = TetId(u);
-      }
+      const uint32_t fresh = (word & bit) == 0;
+      word |= bit;
+      __builtin_prefetch(&tets[8 * u]);
+      star[n] = TetId(u);
+      n += fresh;
     }
   }
   for (uint32_t k = 0; k < n; ++k) tbits[star[k].value() >> 6] = 0;
