@@ -28,6 +28,16 @@ class CollarIndex {
   uint32_t FindContaining(const geom::Vec3& x) const;
   bool StrictlyInside(const geom::Vec3& x) const { return FindContaining(x) != kNone; }
 
+  // Lemma 14: two balls whose spheres intersect meet at a tangent angle
+  // ≥ π/2 iff |c₁c₂|² ≤ r₁² + r₂² (a smooth collar system, Definition 27;
+  // Lemma 17 says SVRC produces one). Counts over all pairs whose spheres
+  // intersect; `worst` = the largest |c₁c₂|² / (r₁² + r₂²) among them.
+  struct Smoothness {
+    uint64_t intersecting = 0, not_smooth = 0;
+    double worst = 0;
+  };
+  Smoothness MeasureSmoothness() const;
+
  private:
   struct Key {
     int32_t level;

@@ -251,6 +251,10 @@ class Refiner {
   // arcs (ArcRepairs); every repair point is destroyed as a gap ball of CD
   // (3,d) / (2,d). Returns whether anything was inserted.
   absl::StatusOr<bool> CollarRound() { return CollarRoundImpl(); }
+  // Lemma 17: consecutive collar balls on one crease segment meeting below
+  // π/2 get a crease point between them (the thesis' encroachment of the
+  // piece by the neck circle); returns whether any was inserted.
+  absl::StatusOr<bool> SplitCollarNecks();
   // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
   absl::Status Stitch() { return StitchImpl(); }
   void ClearStitch() {
@@ -403,6 +407,7 @@ class Refiner {
   CollarIndex collars_;
   std::vector<PointId> collar_centre_;          // per collar
   std::vector<uint8_t> has_collar_;             // per point
+  std::vector<uint8_t> neck_point_;             // per point: SplitCollarNecks' points get a ball even inside a collar
   std::vector<uint8_t> suppressed_;             // per point: 1 once strictly inside a collar
   std::vector<std::vector<uint32_t>> point_segments_;  // per complex point: segments ending there
   bool stitched_done_ = false;
@@ -1502,7 +1507,7 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   // collar surface, and break the chain of consecutive balls RipStitchCollar
   // builds books from (measured on crease_pair_30: the vertex collar crossed
   // the ball of a non-adjacent crease point).
-  if (collars_.StrictlyInside(pos)) {
+  if (!(p.value() < neck_point_.size() && neck_point_[p.value()]) && collars_.StrictlyInside(pos)) {
     ++stats_.collars_skipped_inside;
     return absl::OkStatus();
   }
@@ -1573,7 +1578,13 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
       const double len = geom::Dist(points_.Xyz(m.PointOf(0)), points_.Xyz(m.PointOf(1)));
       if (!(rho < len)) continue;
       const bool at_a = m.PointOf(0) == p;
-      const double t = at_a ? rho / len : 1 - rho / len;
+      double t = at_a ? rho / len : 1 - rho / len;
+      // On the sphere, never strictly inside by rounding: such a (1,2) point
+      // got no ball of its own (CreateCollar skips points strictly inside a
+      // collar), leaving the vertex ball to meet the next chain ball at a
+      // sharp angle, i.e. a collar system that is not smooth (Lemma 17;
+      // measured on a flat tetrahedron: 3 of its 6 (1,2) points skipped).
+      for (int k = 0; k < 64 && geom::InBall(m.PointAt(t), pos, rho) > 0; ++k) t = std::nextafter(t, at_a ? 1.0 : 0.0);
       uint32_t u = 0;
       while (m.Next(u) != SegmentMesh::kNil && m.T(m.Next(u)) <= t) u = m.Next(u);
       if (m.Next(u) == SegmentMesh::kNil || m.T(u) == t || !(t > m.T(u) && t < m.T(m.Next(u)))) continue;
@@ -1600,8 +1611,51 @@ constexpr const char* kCollarRepairName[] = {"topology", "angle", "circle", "siz
 // Smallest RepBall accepted, relative to its collar ball's radius.
 constexpr double kMinCollarRepairRatio = 1e-4;
 
+absl::StatusOr<bool> Refiner::SplitCollarNecks() {
+  std::vector<uint32_t> ball_of(points_.size(), CollarIndex::kNone);
+  for (uint32_t i = 0; i < collar_centre_.size(); ++i) ball_of[collar_centre_[i].value()] = i;
+  bool any = false;
+  for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
+    if (!complex_->segments[sg].crease) continue;
+    SegmentMesh& m = segs_[sg];
+    uint32_t prev = SegmentMesh::kNil;  // last vertex with a ball
+    for (uint32_t u = 0; u != SegmentMesh::kNil; u = m.Next(u)) {
+      const PointId p = m.PointOf(u);
+      if (p.value() >= ball_of.size() || ball_of[p.value()] == CollarIndex::kNone) continue;
+      if (prev != SegmentMesh::kNil) {
+        const CollarBall& a = collars_.ball(ball_of[m.PointOf(prev).value()]);
+        const CollarBall& b = collars_.ball(ball_of[p.value()]);
+        const double d = geom::Dist(a.center, b.center);
+        if (d < a.radius + b.radius && d * d > a.radius * a.radius + b.radius * b.radius) {
+          // The crease point on the neck: where the circle's plane crosses
+          // the segment.
+          const double x = (d * d + a.radius * a.radius - b.radius * b.radius) / (2 * d);
+          const double t = m.T(prev) + (m.T(u) - m.T(prev)) * (x / d);
+          uint32_t w = prev;
+          while (m.Next(w) != u && m.T(m.Next(w)) <= t) w = m.Next(w);
+          if (t > m.T(w) && t < m.T(m.Next(w))) {
+            const uint32_t np = points_.size();
+            if (neck_point_.size() <= np) neck_point_.resize(np + 1024, 0);
+            neck_point_[np] = 1;
+            absl::Status st = ForceInsertSegment(sg, w, t, kCdSegment);
+            if (!st.ok()) return st;
+            ++stats_.neck_splits;
+            any = true;
+          }
+        }
+      }
+      prev = u;
+    }
+  }
+  return any;
+}
+
 absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   if (collars_.size() == 0) return false;
+  if (options_.split_necks) {
+    absl::StatusOr<bool> split = SplitCollarNecks();
+    if (!split.ok() || *split) return split;
+  }
   const CollarDescription desc = BuildCollarDescription(collars_.balls());
   CollarSurfaceOptions copt;
   copt.sigma = options_.max_rep_angle;
@@ -2437,6 +2491,17 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.predicate_calls", static_cast<double>(predicate_calls));
   out->Set("svrc.predicate_exact", static_cast<double>(predicate_exact));
   out->Set("svrc.predicate_sos", static_cast<double>(predicate_sos));
+  out->Set("svrc.collars", static_cast<double>(collars));
+  out->Set("svrc.vertex_collars", static_cast<double>(vertex_collars));
+  out->Set("svrc.collars_skipped_inside", static_cast<double>(collars_skipped_inside));
+  out->Set("svrc.points_12", static_cast<double>(points_12));
+  out->Set("svrc.neck_splits", static_cast<double>(neck_splits));
+  out->Set("svrc.collar_rounds", static_cast<double>(collar_rounds));
+  out->Set("svrc.collar_repairs", static_cast<double>(collar_repairs));
+  out->Set("svrc.arc_repairs", static_cast<double>(arc_repairs));
+  out->Set("svrc.collar_pairs", static_cast<double>(collar_pairs));
+  out->Set("svrc.collar_pairs_not_smooth", static_cast<double>(collar_pairs_not_smooth));
+  out->Set("svrc.collar_worst_smoothness", collar_worst_smoothness);
   out->Set("svrc.seconds_refine", seconds);
 }
 
@@ -2560,7 +2625,16 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
     bool settled = false;
     for (int round = 0; round < kMaxCollarRounds; ++round) {
       absl::StatusOr<bool> more = refiner.CollarRound();
-      if (!more.ok()) return more.status();
+      if (!more.ok()) {
+        // The collar system's smoothness (Lemma 14) in the message: every
+        // input that stopped here so far had balls meeting below π/2.
+        const CollarIndex::Smoothness sm = refiner.collars().MeasureSmoothness();
+        if (sm.not_smooth == 0) return more.status();
+        return absl::Status(more.status().code(),
+                            absl::StrCat(more.status().message(), "; the collar system is not smooth: ", sm.not_smooth,
+                                         " of ", sm.intersecting, " intersecting ball pairs meet below 90 degrees ",
+                                         "(worst |c1c2|^2/(r1^2+r2^2) = ", sm.worst, ", Lemma 14)"));
+      }
       if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
         const CollarSurfaceReport& r = refiner.surface_report_;
         std::fprintf(stderr, "collar round %d: repairs topo %d angle %d circle %d size %d; bad roots %d facets %d links %d spherelinks %d empty %d circles %d bound %d angles %d; total 3D %u arcs %u crossings %u centres %u\n",
@@ -2620,6 +2694,10 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   out.stats.collar_rounds = refiner.collar_rounds_;
   out.stats.collar_repairs = refiner.collar_repairs_;
   out.stats.arc_repairs = refiner.arc_repairs_;
+  const CollarIndex::Smoothness sm = refiner.collars().MeasureSmoothness();
+  out.stats.collar_pairs = sm.intersecting;
+  out.stats.collar_pairs_not_smooth = sm.not_smooth;
+  out.stats.collar_worst_smoothness = sm.worst;
   return out;
 }
 

@@ -63,6 +63,13 @@ struct RefineOptions {
   // = false, eps = 0): the rounds converge, but arc chords are not
   // guaranteed, so facets inside collars may not be sealed (measured).
   bool loose_arcs = false;
+  // Lemma 17 enforced: a crease point (with its own collar ball) between
+  // consecutive collar balls of a crease segment that meet below π/2.
+  // core::MeshPlc turns it on only to retry an input whose collar stage did
+  // not finish without it (measured: it lets the flat tetrahedron mesh but
+  // breaks RipStitchCollar's star on crease_pair 30°; docs/svrc-collars.md
+  // "Wiring status (session 5)").
+  bool split_necks = false;
   // Snap band of facet arcs, relative to the circle radius (thesis δ, §3.1.2).
   double arc_snap = 0.02;
   // σ: the largest representation angle of the collar surface (radians;
@@ -99,7 +106,11 @@ struct RefineStats {
   uint64_t max_collar_cells = 0;
   uint64_t suppressed_points = 0;  // unresolved points dropped inside collars (Figure 3.9)
   uint64_t points_12 = 0;          // (1,2) points: vertex-collar spheres ∩ segments
+  uint64_t neck_splits = 0;        // crease points between balls meeting below π/2 (Lemma 17)
   uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)
+  uint64_t collar_pairs = 0;       // collar balls whose spheres intersect (pairs)
+  uint64_t collar_pairs_not_smooth = 0;  // of those, meeting below π/2 (Lemma 14)
+  double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
   uint64_t arc_repairs = 0;        // points inserted on facet arcs      // pieces/triangles inside collars left to RipStitchCollar
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued

@@ -97,10 +97,10 @@ TEST(MeshPlcPointSetTest, ProgressAndCancel) {
 
 // A PLC with facets goes to SVRC refinement, never to the point-set path. A
 // flat tetrahedron's facets meet at ~27° at its base: creases below 45° go
-// through the collar stage (issue #6), which does not settle on this input
-// yet (a COLLAR repair below 1e-4 collar radii, docs/svrc-collars.md) and ends
-// FAILED_PRECONDITION naming the crease; a small vertex cap keeps the test
-// fast (6.5 s without it). A lone triangle encloses no volume:
+// through the collar stage (issue #6). Without a cap it meshes (~40 s,
+// tests/svrc/crease_mesh_test.cc CreaseMesh.FlatTetrahedron); a vertex cap of
+// 3000 stops both collar attempts, which ends FAILED_PRECONDITION naming the
+// crease, in about a second. A lone triangle encloses no volume:
 // INVALID_ARGUMENT.
 TEST(MeshPlcPointSetTest, PlcWithCreasesIsRefusedNamingTheCrease) {
   plc::Plc p;

@@ -189,15 +189,16 @@ TEST(CreaseMesh, Wedge1) {
   MeshAndCheck(*plc, "wedge-1.smesh");
 }
 
-// What the collar stage cannot finish yet ends FAILED_PRECONDITION naming
-// the sharpest crease and why, never a mesh that does not conform and never
-// an unbounded run (schonhardt.off ran > 600 s before the RepBall floor).
-// The flat tetrahedron (base creases at 26.6°): its topology repairs grow
-// round after round next to the base plane until one falls below the RepBall
-// floor (docs/svrc-collars.md). Until the longest-gap circle repair was
-// replaced by the largest-RepBall one, it stopped earlier on a circle repair
-// 2.8e-17 from an existing vertex.
-TEST(CreaseMesh, UnfinishedInputsFailNamingTheCrease) {
+// A flat tetrahedron (base creases at 26.6°). Its (1,2) points were strictly
+// inside their vertex balls by rounding and got no balls, and consecutive
+// balls on a base edge met at a sharp angle (10 of 22 intersecting pairs
+// with |c1c2|^2 > r1^2 + r2^2, Lemma 14): topology repairs grew round after
+// round around the thin necks until one fell below the RepBall floor
+// (FAILED_PRECONDITION). With the (1,2) points kept on their spheres and a
+// crease point with its own ball on each such neck (Lemma 17,
+// SplitCollarNecks) it meshes. Before that, a circle repair at the longest
+// gap's midpoint stopped it earlier: 2.8e-17 from an existing vertex.
+TEST(CreaseMesh, FlatTetrahedron) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
 #endif
@@ -208,16 +209,7 @@ TEST(CreaseMesh, UnfinishedInputsFailNamingTheCrease) {
     f.polygons.push_back(plc::Polygon{{t[0], t[1], t[2]}});
     flat.facets.push_back(f);
   }
-  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(flat, {});
-  if (m.ok()) {
-    // Fixed since: then it must be a good mesh (update this test).
-    MeshAndCheck(flat, "flat tetrahedron");
-    ADD_FAILURE() << "the flat tetrahedron meshes now: make it a test of its own";
-    return;
-  }
-  EXPECT_EQ(m.status().code(), absl::StatusCode::kFailedPrecondition) << m.status();
-  EXPECT_NE(m.status().message().find("crease at"), std::string::npos) << m.status();
-  std::printf("flat tetrahedron: %s\n", std::string(m.status().message()).c_str());
+  MeshAndCheck(flat, "flat tetrahedron");
 }
 
 }  // namespace
