@@ -256,8 +256,10 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // order; equal faces are matched inside each bucket through a per-b chain.
   // Same pairs and the same error (the smallest face in > 2 tets) as sorting
   // all records by (key, tet, face), which took ~5% of a volume-bound run.
+  // Kept until the constrained faces are marked below.
+  std::vector<uint32_t> bucket(n + 1, 0);  // faces of smallest vertex a: [bucket[a], bucket[a+1])
+  std::vector<FaceRec> faces;
   {
-    std::vector<uint32_t> bucket(n + 1, 0);  // faces of smallest vertex a: [bucket[a], bucket[a+1])
     for (uint32_t t = 0; t < num_tets; ++t) {
       const Tet& v = tet_[t];
       const uint32_t lo = std::min(std::min(v[0], v[1]), std::min(v[2], v[3]));
@@ -270,7 +272,7 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
       ++bucket[second + 1];
     }
     for (size_t a = 0; a < n; ++a) bucket[a + 1] += bucket[a];
-    std::vector<FaceRec> faces(bucket[n]);
+    faces.resize(bucket[n]);
     {
       std::vector<uint32_t> fill(bucket.begin(), bucket.end() - 1);
       for (uint32_t t = 0; t < num_tets; ++t) {
@@ -360,6 +362,19 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   }
   std::sort(cedges_.begin(), cedges_.end());
   cedges_.erase(std::unique(cedges_.begin(), cedges_.end()), cedges_.end());
+  // Constrained faces per tet (bit f: the face opposite f), found in the
+  // bucket of their smallest vertex: the flood below then tests a bit, not
+  // FaceKey + a binary search over cfaces_ for each of the 4T faces. A face
+  // that is not in the mesh marks nothing (CheckConstraints reports it).
+  std::vector<uint8_t> constrained(num_tets, 0);
+  for (const Tri& k : cfaces_) {
+    for (uint32_t i = bucket[k[0]]; i < bucket[k[0] + 1]; ++i) {
+      const Tri& fk = faces[i].key;
+      if (fk[1] == k[1] && fk[2] == k[2]) constrained[faces[i].tet] |= static_cast<uint8_t>(1u << faces[i].face);
+    }
+  }
+  faces = {};
+  bucket = {};
   absl::Status s = CheckConstraints();
   if (!s.ok()) return s;
   // Components: flood fill across non-constrained faces, in tet order.
@@ -377,7 +392,7 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
       component_max_volume_[c] = std::max(component_max_volume_[c], quality_[t].volume);
       for (int f = 0; f < 4; ++f) {
         const uint32_t n = nbr_[t][f];
-        if (n == kNone || component_[n] != kNone || FaceConstrained(FaceKey(tet_[t], f))) continue;
+        if (n == kNone || component_[n] != kNone || ((constrained[t] >> f) & 1)) continue;
         component_[n] = c;
         stack.push_back(n);
       }
