@@ -469,6 +469,40 @@ TEST(PredicatesTest, ExtraPredicatesMatchOracle) {
   EXPECT_GT(cases, N(20000));
 }
 
+// CompareDistance's own exact stage (exact coordinate differences: squares as
+// TwoProducts, Grow-Expansion) and its generic fallback (inexact
+// differences), against the rational oracle on exact ties and 1-ulp nudges:
+// b = p + a permutation / sign flip of a − p (equal distances), at every
+// frame's scale and offset, with random and with wide-mantissa differences.
+TEST(PredicatesTest, CompareDistanceTiesMatchOracle) {
+  Gen g(20261121);
+  int zeros = 0, cases = 0;
+  for (const Frame& f : kFrames) {
+    for (int i = 0; i < N(3000); ++i) {
+      const Vec3 p = g.Point3(i % 2 ? 1 : 1e-3);
+      Vec3 d = g.Point3();
+      if (i % 3 == 0) d = {std::ldexp(std::round(std::ldexp(d.x, 20)), -20), d.y, d.z};
+      const double c[3] = {d.x, d.y, d.z};
+      const int perm = g.Int(0, 5), flips = g.Int(0, 7);
+      static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+      Vec3 e{c[kPerm[perm][0]], c[kPerm[perm][1]], c[kPerm[perm][2]]};
+      if (flips & 1) e.x = -e.x;
+      if (flips & 2) e.y = -e.y;
+      if (flips & 4) e.z = -e.z;
+      std::array<Vec3, 3> q = {Apply(f, p), Apply(f, p + d), Apply(f, p + e)};
+      for (int nudge = 0; nudge < 3; ++nudge) {
+        const int want = OracleCompareDistance(q[0], q[1], q[2]);
+        ASSERT_EQ(CompareDistance(q[0], q[1], q[2]), want) << "frame " << f.k << " case " << i;
+        ASSERT_EQ(CompareDistance(q[0], q[2], q[1]), -want);
+        zeros += want == 0;
+        ++cases;
+        g.NudgeOneUlp(q);
+      }
+    }
+  }
+  EXPECT_GT(zeros, cases / 20);  // the ties are really exercised
+}
+
 // ------------------------------------------------------ SoS
 
 // Oracle for the SoS orientation: the perturbed determinant evaluated exactly
