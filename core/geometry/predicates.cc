@@ -605,6 +605,22 @@ int CompareDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
   // stage of its own for the common case of exact coordinate differences
   // (~90% of the calls that reach it on volume-bound corpus runs).
   internal::CountCall(Pred::kCompareDistance);
+  // Static pre-filter: with x_i = fl(p_i − a_i), y_i = fl(p_i − b_i),
+  // A = Σ fl(x_i²), B = Σ fl(y_i²), each computed square is within
+  // (3u + O(u²))·fl(x_i²) of the exact (p_i − a_i)², the two 3-term sums add
+  // at most 2u·A and 2u·B, the final difference u·|A − B|: |fl(A − B) − exact|
+  // <= 6u·(A + B) (1 + O(u)) < 1e-15·(A + B) (u = 2^-53). 1e-300 covers
+  // underflow (as Fp's kTiny); NaN/Inf never pass. A certain sign here is the
+  // exact sign, so the result is the same; what it leaves goes through the
+  // running-error filter (Fp) and the exact stages below as before (the
+  // exact-call counter is unchanged).
+  {
+    const double x0 = p.x - a.x, x1 = p.y - a.y, x2 = p.z - a.z;
+    const double y0 = p.x - b.x, y1 = p.y - b.y, y2 = p.z - b.z;
+    const double sa = x0 * x0 + x1 * x1 + x2 * x2, sb = y0 * y0 + y1 * y1 + y2 * y2;
+    const double v = sa - sb;
+    if (std::fabs(v) > 1e-15 * (sa + sb) + 1e-300) return v > 0 ? 1 : -1;
+  }
   bool certain = false;
   const int s = FilteredSign(CompareDistancePoly<Fp>(p, a, b), &certain);
   if (certain) return s;
