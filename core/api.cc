@@ -201,24 +201,6 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     if (options.max_vertices == 0 || options.max_vertices > crease_budget) options.max_vertices = crease_budget;
   }
   absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
-  if (use_collars && !refined.ok() &&
-      (refined.status().code() == absl::StatusCode::kResourceExhausted ||
-       refined.status().code() == absl::StatusCode::kFailedPrecondition)) {
-    // Second attempt with Lemma 17 enforced (thin necks between consecutive
-    // collar balls split by a crease point with its own ball). Not the first
-    // attempt: it breaks RipStitchCollar's star on crease_pair 30°, while the
-    // flat tetrahedron only meshes with it (docs/svrc-collars.md "Wiring
-    // status (session 5)").
-    const absl::Status first = refined.status();
-    options.split_necks = true;
-    report("refine", 0, 0, 0);
-    refined = refine::RefinePlc(*complex, options);
-    if (!refined.ok() && refined.status().code() != absl::StatusCode::kCancelled) {
-      refined = absl::Status(refined.status().code(),
-                             absl::StrCat(refined.status().message(), " (first attempt, without neck splits: ",
-                                          first.message(), ")"));
-    }
-  }
   if (!refined.ok()) {
     if (!crease.empty() && !use_collars && refined.status().code() == absl::StatusCode::kResourceExhausted) {
       return absl::FailedPreconditionError(absl::StrCat(

@@ -255,6 +255,9 @@ class Refiner {
   // π/2 get a crease point between them (the thesis' encroachment of the
   // piece by the neck circle); returns whether any was inserted.
   absl::StatusOr<bool> SplitCollarNecks();
+  // After a failed stitch: the representation points of T′ faces whose star
+  // is inverted go in as COLLAR repairs (CD (3,2)); returns how many.
+  absl::StatusOr<uint32_t> RepairStitchFailures();
   // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
   absl::Status Stitch() { return StitchImpl(); }
   void ClearStitch() {
@@ -407,6 +410,7 @@ class Refiner {
   CollarIndex collars_;
   std::vector<PointId> collar_centre_;          // per collar
   std::vector<uint8_t> has_collar_;             // per point
+  std::vector<std::pair<Vec3, uint32_t>> stitch_failures_;  // (rep point on S, ball) of the last failed stitch
   std::vector<uint8_t> neck_point_;             // per point: SplitCollarNecks' points get a ball even inside a collar
   std::vector<uint8_t> suppressed_;             // per point: 1 once strictly inside a collar
   std::vector<std::vector<uint32_t>> point_segments_;  // per complex point: segments ending there
@@ -1650,6 +1654,29 @@ absl::StatusOr<bool> Refiner::SplitCollarNecks() {
   return any;
 }
 
+absl::StatusOr<uint32_t> Refiner::RepairStitchFailures() {
+  // A T′ face whose star over its ball's centre is inverted lies nearly
+  // edge-on to the centre; its Voronoi edge's root x on S is the centre of
+  // its empty RepBall, so inserting x destroys the face (as an angle repair
+  // would). The COLLAR rounds settled on snapped positions; the stitch sees
+  // the unsnapped ones (measured: crease_pair 30° with neck splits, one
+  // inverted star at ball 7).
+  const delaunay::Delaunay3& dt = omega_.dt();
+  uint32_t inserted = 0;
+  for (const auto& [x, ball] : stitch_failures_) {
+    const VertexId v = dt.NearestVertex(x);
+    const double r = geom::Dist(dt.Point(v), x);
+    if (!(r > kMinCollarRepairRatio * collars_.ball(ball).radius)) continue;
+    absl::Status st = DestroyOmegaAt(x, r, dt.VertexTet(v), v, Cd{3, 2});
+    if (!st.ok()) return st;
+    ++collar_repairs_;
+    ++inserted;
+  }
+  stitch_failures_.clear();
+  if (inserted > 0) ClearStitch();
+  return inserted;
+}
+
 absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   if (collars_.size() == 0) return false;
   if (options_.split_necks) {
@@ -1954,6 +1981,10 @@ absl::Status Refiner::StitchImpl() {
                    features_.Index(f), collars_.ball(i).center.x, collars_.ball(i).center.y, collars_.ball(i).center.z,
                    collars_.ball(i).radius);
     }
+  }
+  stitch_failures_.clear();
+  for (const StitchFailure& f : failures) {
+    if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.emplace_back(f.where, f.ball);
   }
   if (!r.ok()) return r.status();
   stitch_report_ = *r;
@@ -2615,7 +2646,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
     s = refiner.Run();
     if (!s.ok()) return s;
   }
-  int crossing_passes = 0, size_passes = 0;
+  int crossing_passes = 0, size_passes = 0, stitch_repair_passes = 0;
   for (int stitch_pass = 0;; ++stitch_pass) {
   if (options.collars && options.collar_surface) {
     // COLLAR events, then RipStitchCollar (Figure 3.2's last line).
@@ -2660,7 +2691,17 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   if (!s.ok()) return s;
   if (!(options.collars && options.collar_surface && refiner.collars().size() > 0)) break;
   s = refiner.Stitch();
-  if (!s.ok()) return s;
+  if (!s.ok()) {
+    absl::StatusOr<uint32_t> fixed = refiner.RepairStitchFailures();
+    if (!fixed.ok()) return fixed.status();
+    if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
+      std::fprintf(stderr, "stitch failed: %u inverted stars repaired\n", *fixed);
+    }
+    if (*fixed == 0 || ++stitch_repair_passes == 8) return s;
+    s = refiner.Run();
+    if (!s.ok()) return s;
+    continue;
+  }
   absl::StatusOr<uint32_t> crossings = refiner.RepairStitchedCrossings();
   if (!crossings.ok()) return crossings.status();
   if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {

@@ -64,12 +64,10 @@ struct RefineOptions {
   // guaranteed, so facets inside collars may not be sealed (measured).
   bool loose_arcs = false;
   // Lemma 17 enforced: a crease point (with its own collar ball) between
-  // consecutive collar balls of a crease segment that meet below π/2.
-  // core::MeshPlc turns it on only to retry an input whose collar stage did
-  // not finish without it (measured: it lets the flat tetrahedron mesh but
-  // breaks RipStitchCollar's star on crease_pair 30°; docs/svrc-collars.md
+  // consecutive collar balls of a crease segment that meet below π/2
+  // (measured: the flat tetrahedron meshes only with it; docs/svrc-collars.md
   // "Wiring status (session 5)").
-  bool split_necks = false;
+  bool split_necks = true;
   // Snap band of facet arcs, relative to the circle radius (thesis δ, §3.1.2).
   double arc_snap = 0.02;
   // σ: the largest representation angle of the collar surface (radians;

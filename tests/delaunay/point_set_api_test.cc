@@ -99,8 +99,8 @@ TEST(MeshPlcPointSetTest, ProgressAndCancel) {
 // flat tetrahedron's facets meet at ~27° at its base: creases below 45° go
 // through the collar stage (issue #6). Without a cap it meshes (~40 s,
 // tests/svrc/crease_mesh_test.cc CreaseMesh.FlatTetrahedron); a vertex cap of
-// 3000 stops both collar attempts, which ends FAILED_PRECONDITION naming the
-// crease, in about a second. A lone triangle encloses no volume:
+// 3000 stops the collar stage, which ends FAILED_PRECONDITION naming the
+// crease, in well under a second. A lone triangle encloses no volume:
 // INVALID_ARGUMENT.
 TEST(MeshPlcPointSetTest, PlcWithCreasesIsRefusedNamingTheCrease) {
   plc::Plc p;

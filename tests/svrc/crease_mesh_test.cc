@@ -189,6 +189,27 @@ TEST(CreaseMesh, Wedge1) {
   MeshAndCheck(*plc, "wedge-1.smesh");
 }
 
+// The other generated crease families of issue #6: a free segment leaving a
+// facet at a small angle, and fans of facets around one edge (svrc_plc_bench
+// --family segment_facet_10deg/_1deg, fan_6x60deg, fan_8x5deg: all four
+// conform, radius-edge <= 2 away from creases).
+TEST(CreaseMesh, SegmentFacetAndFans) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  MeshAndCheck(plc::families::SegmentFacetAngle(10), "segment_facet_10deg");
+  MeshAndCheck(plc::families::SegmentFacetAngle(1), "segment_facet_1deg");
+  MeshAndCheck(plc::families::FacetFan(6, 60), "fan_6x60deg");
+}
+
+// Eight facets 5° apart around one edge: ~166,000 tets, ~27 s.
+TEST(CreaseMesh, Fan8x5) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  MeshAndCheck(plc::families::FacetFan(8, 5), "fan_8x5deg");
+}
+
 // A flat tetrahedron (base creases at 26.6°). Its (1,2) points were strictly
 // inside their vertex balls by rounding and got no balls, and consecutive
 // balls on a base edge met at a sharp angle (10 of 22 intersecting pairs
@@ -196,7 +217,7 @@ TEST(CreaseMesh, Wedge1) {
 // round around the thin necks until one fell below the RepBall floor
 // (FAILED_PRECONDITION). With the (1,2) points kept on their spheres and a
 // crease point with its own ball on each such neck (Lemma 17,
-// SplitCollarNecks) it meshes. Before that, a circle repair at the longest
+// SplitCollarNecks) it meshes (~22 s). Before that, a circle repair at the longest
 // gap's midpoint stopped it earlier: 2.8e-17 from an existing vertex.
 TEST(CreaseMesh, FlatTetrahedron) {
 #if defined(__SANITIZE_ADDRESS__)
