@@ -190,9 +190,21 @@ std::vector<Arc> ClipCircleByBalls(const Circle3& circle, std::span<const Collar
   return arcs;
 }
 
+namespace {
+// A cull before the exact test, not a decision: x is outside b's bounding box
+// on some axis. A difference of two doubles has relative error ≤ u, so a
+// computed |x_i − c_i| > r·(1 + 1e-9) means the true one exceeds r. Measured:
+// the exact InBall over every ball for every root was 22% of wedge-1.smesh's
+// time (964 balls, 57 COLLAR rounds).
+bool OutsideBox(const Vec3& x, const CollarBall& b) {
+  const double r = b.radius * (1 + 1e-9);
+  return std::fabs(x.x - b.center.x) > r || std::fabs(x.y - b.center.y) > r || std::fabs(x.z - b.center.z) > r;
+}
+}  // namespace
+
 bool OnCollarSurface(const Vec3& x, uint32_t self, std::span<const CollarBall> balls) {
   for (uint32_t j = 0; j < balls.size(); ++j) {
-    if (j == self) continue;
+    if (j == self || OutsideBox(x, balls[j])) continue;
     if (geom::InBall(x, balls[j].center, balls[j].radius) > 0) return false;
   }
   return true;
@@ -200,6 +212,7 @@ bool OnCollarSurface(const Vec3& x, uint32_t self, std::span<const CollarBall> b
 
 bool InsideAnyBall(const Vec3& p, std::span<const CollarBall> balls) {
   for (const CollarBall& b : balls) {
+    if (OutsideBox(p, b)) continue;
     if (geom::InBall(p, b.center, b.radius) > 0) return true;
   }
   return false;
