@@ -1011,6 +1011,13 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy (facet) yielded without end");
+    // A long yield chain inside one Destroy never reaches Run()'s poll
+    // (measured: f_real/hinge.stl spent > 15 min in one DestroyFacet and
+    // ignored a 900 s deadline): cancellation and deadlines are polled here too.
+    if (attempt > 0 && attempt % 256 == 0 && options_.poll) {
+      absl::Status polled = options_.poll();
+      if (!polled.ok()) return polled;
+    }
     // Each yield inserts into a segment mesh: the budget bounds the chain.
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached"));
@@ -1117,6 +1124,13 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy yielded without end");
+    // A long yield chain inside one Destroy never reaches Run()'s poll
+    // (measured: f_real/hinge.stl spent > 15 min in one DestroyFacet and
+    // ignored a 900 s deadline): cancellation and deadlines are polled here too.
+    if (attempt > 0 && attempt % 256 == 0 && options_.poll) {
+      absl::Status polled = options_.poll();
+      if (!polled.ok()) return polled;
+    }
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached"));
     }
