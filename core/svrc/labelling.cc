@@ -10,17 +10,12 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/geometry/predicates.h"
+#include "core/svrc/tet_faces.h"
 
 namespace svrc::refine {
 namespace {
 
 using geom::Vec3;
-
-// One face of one tet: its sorted vertex ids and its slot 4t+f (the face
-// opposite local vertex f of tet t).
-struct FaceRec {
-  uint32_t a, b, c, slot;
-};
 
 std::array<uint32_t, 3> Sorted3(std::array<uint32_t, 3> v) {
   std::sort(v.begin(), v.end());
@@ -193,100 +188,25 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   }
 
   // --- Face adjacency: group the 4T faces by their vertex sets. -------------
-  // A face is (a, b, c, slot) with a < b < c its sorted vertex ids. A
-  // counting sort on a puts the ~25 faces whose smallest vertex is a in one
-  // bucket, in slot order (records enter in slot order); equal faces are
-  // then matched inside each bucket. Same pairs, same first (smallest-slot)
-  // record per face and same error as sorting all 4T records by
-  // (a, b, c, slot), without the sort (it took ~60% of the labelling).
-  std::vector<FaceRec> faces(4 * nt);
-  std::vector<uint32_t> bucket(nv + 1, 0);  // faces of smallest vertex a: [bucket[a], bucket[a+1])
-  {
-    // The faces of tet t from its sorted vertices s0 < s1 < s2 < s3: leaving
-    // out s_i gives a sorted face, slot 4t + (position of s_i in the tet).
-    auto for_faces = [&](size_t t, auto&& emit) {
-      const auto& tv = in.tets[t];
-      std::array<uint64_t, 4> s;
-      for (int i = 0; i < 4; ++i) s[i] = (static_cast<uint64_t>(tv[i]) << 2) | static_cast<uint64_t>(i);
-      // Sorting network on (vertex, position); positions break no ties
-      // between distinct vertices.
-      auto cswap = [&](int i, int j) {
-        if (s[j] < s[i]) std::swap(s[i], s[j]);
-      };
-      cswap(0, 1);
-      cswap(2, 3);
-      cswap(0, 2);
-      cswap(1, 3);
-      cswap(1, 2);
-      const uint32_t base = static_cast<uint32_t>(4 * t);
-      const uint32_t v0 = static_cast<uint32_t>(s[0] >> 2), v1 = static_cast<uint32_t>(s[1] >> 2),
-                     v2 = static_cast<uint32_t>(s[2] >> 2), v3 = static_cast<uint32_t>(s[3] >> 2);
-      emit(FaceRec{v1, v2, v3, base + static_cast<uint32_t>(s[0] & 3)});
-      emit(FaceRec{v0, v2, v3, base + static_cast<uint32_t>(s[1] & 3)});
-      emit(FaceRec{v0, v1, v3, base + static_cast<uint32_t>(s[2] & 3)});
-      emit(FaceRec{v0, v1, v2, base + static_cast<uint32_t>(s[3] & 3)});
-    };
-    for (size_t t = 0; t < nt; ++t) for_faces(t, [&](const FaceRec& r) { ++bucket[r.a + 1]; });
-    for (size_t v = 0; v < nv; ++v) bucket[v + 1] += bucket[v];
-    std::vector<uint32_t> fill(bucket.begin(), bucket.end() - 1);
-    for (size_t t = 0; t < nt; ++t) for_faces(t, [&](const FaceRec& r) { faces[fill[r.a]++] = r; });
-  }
-  // Match equal faces inside each bucket (no sort): a face (a, b, c) finds
-  // the earlier ones with the same b through a per-b chain (head stamped
-  // with a), then compares c. Each record knows the first record of its key
-  // (the smallest slot, as the bucket is in slot order). Two records: the
-  // tets are neighbours; more: not a tetrahedralization (reported for the
-  // smallest (a, b, c), with its three smallest slots).
+  // Bucketed by smallest vertex and matched inside each bucket (tet_faces.h):
+  // same pairs, same first (smallest-slot) record per face and same error as
+  // sorting all 4T records by (a, b, c, slot), without the sort (it took ~60%
+  // of the labelling). Two records: the tets are neighbours; more: not a
+  // tetrahedralization (reported for the smallest (a, b, c), with its three
+  // smallest slots).
+  const TetFaces tet_faces(in.tets, nv);
   std::vector<uint32_t> nbr(4 * nt, kNoTet);  // slot -> opposite slot
   {
-    constexpr uint32_t kNil = 0xFFFFFFFFu;
-    std::vector<uint32_t> head(nv), head_a(nv, kNil);
-    std::vector<uint32_t> chain, first, count;
-    for (size_t a = 0; a < nv; ++a) {
-      const uint32_t lo = bucket[a], n = bucket[a + 1] - lo;
-      if (n == 0) continue;
-      const FaceRec* r = faces.data() + lo;
-      if (chain.size() < n) {
-        chain.resize(n);
-        first.resize(n);
-        count.resize(n);
-      }
-      uint32_t bad = kNil;  // the record of the smallest (b, c) in > 2 tets
-      for (uint32_t k = 0; k < n; ++k) {
-        const uint32_t b = r[k].b;
-        const uint32_t prev = head_a[b] == a ? head[b] : kNil;
-        uint32_t f = kNil;
-        for (uint32_t j = prev; j != kNil; j = chain[j]) {
-          if (r[j].c == r[k].c) {
-            f = first[j];
-            break;
-          }
-        }
-        chain[k] = prev;
-        head[b] = k;
-        head_a[b] = static_cast<uint32_t>(a);
-        if (f == kNil) {
-          first[k] = k;
-          count[k] = 1;
-          continue;
-        }
-        first[k] = f;
-        if (++count[f] == 2) {
-          nbr[r[f].slot] = r[k].slot;
-          nbr[r[k].slot] = r[f].slot;
-        } else if (bad == kNil || r[f].b < r[bad].b || (r[f].b == r[bad].b && r[f].c < r[bad].c)) {
-          bad = f;
-        }
-      }
-      if (bad != kNil) {
-        uint32_t slots[3], m = 0;
-        for (uint32_t k = bad; k < n && m < 3; ++k) {
-          if (r[k].b == r[bad].b && r[k].c == r[bad].c) slots[m++] = r[k].slot;
-        }
-        return absl::InvalidArgumentError(absl::StrCat(
-            "face (", a, ", ", r[bad].b, ", ", r[bad].c, ") is in ", count[bad], " tets (",
-            slots[0] / 4, ", ", slots[1] / 4, ", ", slots[2] / 4, ", ...): not a tetrahedralization"));
-      }
+    TetFaces::Overused bad;
+    if (!tet_faces.Match(
+            [&](uint32_t s, uint32_t t) {
+              nbr[s] = t;
+              nbr[t] = s;
+            },
+            &bad)) {
+      return absl::InvalidArgumentError(absl::StrCat("face (", bad.a, ", ", bad.b, ", ", bad.c, ") is in ",
+                                                     bad.count, " tets (", bad.slots[0] / 4, ", ", bad.slots[1] / 4,
+                                                     ", ", bad.slots[2] / 4, ", ...): not a tetrahedralization"));
     }
   }
 
@@ -324,10 +244,10 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
         continue;
       }
       // The face's first record (smallest slot) in the bucket of k[0].
-      const FaceRec* it = nullptr;
-      for (uint32_t i = bucket[k[0]]; i < bucket[k[0] + 1]; ++i) {
-        if (faces[i].b == k[1] && faces[i].c == k[2]) {
-          it = &faces[i];
+      const TetFace* it = nullptr;
+      for (const TetFace& f : tet_faces.Bucket(k[0])) {
+        if (f.b == k[1] && f.c == k[2]) {
+          it = &f;
           break;
         }
       }

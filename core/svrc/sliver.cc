@@ -6,13 +6,16 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <queue>
+#include <span>
 #include <tuple>
 #include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/geometry/predicates.h"
+#include "core/svrc/tet_faces.h"
 
 namespace svrc::refine {
 namespace {
@@ -238,12 +241,6 @@ int LocalIndex(const Tet& t, uint32_t v) {
   return -1;
 }
 
-struct FaceRec {
-  Tri key;
-  uint32_t tet;
-  int face;
-};
-
 absl::Status FlipMesh::Init(const SliverInput& in) {
   const size_t n = pos_.size();
   const size_t num_tets = in.tets.size();
@@ -273,97 +270,21 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
     quality_[t] = Measure(pos_, v);
   }
   // Adjacency: the 4T faces grouped by their vertex sets, as LabelRegions
-  // does (no hashing, no sort of all 4T records): a counting sort on the
-  // smallest vertex a puts the ~25 faces of a in one bucket, in (tet, face)
-  // order; equal faces are matched inside each bucket through a per-b chain.
-  // Same pairs and the same error (the smallest face in > 2 tets) as sorting
-  // all records by (key, tet, face), which took ~5% of a volume-bound run.
-  // Kept until the constrained faces are marked below.
-  std::vector<uint32_t> bucket(n + 1, 0);  // faces of smallest vertex a: [bucket[a], bucket[a+1])
-  std::vector<FaceRec> faces;
+  // does (tet_faces.h: no hashing, no sort of all 4T records, which took ~5%
+  // of a volume-bound run). Same pairs and the same error (the smallest face
+  // in > 2 tets) as sorting all records by (key, tet, face). Kept until the
+  // constrained faces are marked below.
+  std::optional<TetFaces> tet_faces(std::in_place, std::span<const Tet>(tet_), n);
   {
-    for (uint32_t t = 0; t < num_tets; ++t) {
-      const Tet& v = tet_[t];
-      const uint32_t lo = std::min(std::min(v[0], v[1]), std::min(v[2], v[3]));
-      // The face without the smallest vertex starts at the second smallest.
-      uint32_t second = kNone;
-      for (int i = 0; i < 4; ++i) {
-        if (v[i] != lo) second = std::min(second, v[i]);
-      }
-      bucket[lo + 1] += 3;
-      ++bucket[second + 1];
-    }
-    for (size_t a = 0; a < n; ++a) bucket[a + 1] += bucket[a];
-    faces.resize(bucket[n]);
-    {
-      std::vector<uint32_t> fill(bucket.begin(), bucket.end() - 1);
-      for (uint32_t t = 0; t < num_tets; ++t) {
-        // Sorted (vertex, position) pairs: leaving out s_i gives the sorted
-        // key of the face opposite position s_i (as FaceKey).
-        std::array<uint64_t, 4> s;
-        for (int i = 0; i < 4; ++i) s[i] = (static_cast<uint64_t>(tet_[t][i]) << 2) | static_cast<uint64_t>(i);
-        auto cswap = [&](int i, int j) {
-          if (s[j] < s[i]) std::swap(s[i], s[j]);
-        };
-        cswap(0, 1);
-        cswap(2, 3);
-        cswap(0, 2);
-        cswap(1, 3);
-        cswap(1, 2);
-        const uint32_t v0 = static_cast<uint32_t>(s[0] >> 2), v1 = static_cast<uint32_t>(s[1] >> 2),
-                       v2 = static_cast<uint32_t>(s[2] >> 2), v3 = static_cast<uint32_t>(s[3] >> 2);
-        // In face order f = 0..3 within the tet, as the records were sorted by.
-        FaceRec rec[4];
-        rec[s[0] & 3] = FaceRec{Tri{v1, v2, v3}, t, static_cast<int>(s[0] & 3)};
-        rec[s[1] & 3] = FaceRec{Tri{v0, v2, v3}, t, static_cast<int>(s[1] & 3)};
-        rec[s[2] & 3] = FaceRec{Tri{v0, v1, v3}, t, static_cast<int>(s[2] & 3)};
-        rec[s[3] & 3] = FaceRec{Tri{v0, v1, v2}, t, static_cast<int>(s[3] & 3)};
-        for (int f = 0; f < 4; ++f) faces[fill[rec[f].key[0]]++] = rec[f];
-      }
-    }
-    constexpr uint32_t kNil = kNone;
-    std::vector<uint32_t> head(n), head_a(n, kNil);
-    std::vector<uint32_t> chain, first, count;
-    for (size_t a = 0; a < n; ++a) {
-      const uint32_t lo = bucket[a], m = bucket[a + 1] - lo;
-      if (m == 0) continue;
-      const FaceRec* r = faces.data() + lo;
-      if (chain.size() < m) {
-        chain.resize(m);
-        first.resize(m);
-        count.resize(m);
-      }
-      uint32_t bad = kNil;  // the record of the smallest (b, c) in > 2 tets
-      for (uint32_t k = 0; k < m; ++k) {
-        const uint32_t b = r[k].key[1];
-        const uint32_t prev = head_a[b] == a ? head[b] : kNil;
-        uint32_t f = kNil;
-        for (uint32_t j = prev; j != kNil; j = chain[j]) {
-          if (r[j].key[2] == r[k].key[2]) {
-            f = first[j];
-            break;
-          }
-        }
-        chain[k] = prev;
-        head[b] = k;
-        head_a[b] = static_cast<uint32_t>(a);
-        if (f == kNil) {
-          first[k] = k;
-          count[k] = 1;
-          continue;
-        }
-        first[k] = f;
-        if (++count[f] == 2) {
-          nbr_[r[f].tet][r[f].face] = r[k].tet;
-          nbr_[r[k].tet][r[k].face] = r[f].tet;
-        } else if (bad == kNil || r[f].key < r[bad].key) {
-          bad = f;
-        }
-      }
-      if (bad != kNil) {
-        return absl::InvalidArgumentError(absl::StrCat("sliver: face (", r[bad].key[0], ", ", r[bad].key[1], ", ",
-                                                       r[bad].key[2], ") is in ", count[bad], " tets"));
-      }
+    TetFaces::Overused bad;
+    if (!tet_faces->Match(
+            [&](uint32_t s, uint32_t t) {
+              nbr_[s / 4][s % 4] = t / 4;
+              nbr_[t / 4][t % 4] = s / 4;
+            },
+            &bad)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("sliver: face (", bad.a, ", ", bad.b, ", ", bad.c, ") is in ", bad.count, " tets"));
     }
   }
   for (const Tri& f : in.constrained_faces) {
@@ -390,13 +311,11 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // that is not in the mesh marks nothing (CheckConstraints reports it).
   std::vector<uint8_t> constrained(num_tets, 0);
   for (const Tri& k : cfaces_) {
-    for (uint32_t i = bucket[k[0]]; i < bucket[k[0] + 1]; ++i) {
-      const Tri& fk = faces[i].key;
-      if (fk[1] == k[1] && fk[2] == k[2]) constrained[faces[i].tet] |= static_cast<uint8_t>(1u << faces[i].face);
+    for (const TetFace& f : tet_faces->Bucket(k[0])) {
+      if (f.b == k[1] && f.c == k[2]) constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4));
     }
   }
-  faces = {};
-  bucket = {};
+  tet_faces.reset();
   absl::Status s = CheckConstraints();
   if (!s.ok()) return s;
   // Components: flood fill across non-constrained faces, in tet order.

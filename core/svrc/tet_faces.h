@@ -1,0 +1,49 @@
+// Face adjacency of a tetrahedralization without hashing and without a
+// global sort (docs/svrc-output.md): the 4T faces are bucketed by their
+// smallest vertex (a counting sort) and equal faces are matched inside each
+// bucket. Shared by LabelRegions (labelling.h) and the sliver pass (sliver.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "absl/functional/function_ref.h"
+
+namespace svrc::refine {
+
+// One face of one tet: its sorted vertex ids a < b < c and its slot
+// 4t + f (the face opposite local vertex f of tet t).
+struct TetFace {
+  uint32_t a, b, c, slot;
+};
+
+class TetFaces {
+ public:
+  // Vertex ids of `tets` must be < num_vertices (the callers check).
+  TetFaces(std::span<const std::array<uint32_t, 4>> tets, size_t num_vertices);
+
+  // The faces whose smallest vertex is a, in tet order (so the records of
+  // one face come smallest slot first).
+  std::span<const TetFace> Bucket(uint32_t a) const {
+    return {faces_.data() + bucket_[a], faces_.data() + bucket_[a + 1]};
+  }
+
+  // A face shared by more than two tets: not a tetrahedralization.
+  struct Overused {
+    uint32_t a = 0, b = 0, c = 0;
+    uint32_t count = 0;
+    std::array<uint32_t, 3> slots{};  // its three smallest slots
+  };
+  // Calls pair(s, t) once for the two slots of each face in two tets. Stops
+  // at the first bucket holding a face in more than two tets and returns
+  // false with *bad = the smallest such face (a, b, c).
+  bool Match(absl::FunctionRef<void(uint32_t, uint32_t)> pair, Overused* bad) const;
+
+ private:
+  std::vector<uint32_t> bucket_;  // faces of smallest vertex a: [bucket_[a], bucket_[a+1])
+  std::vector<TetFace> faces_;
+};
+
+}  // namespace svrc::refine
