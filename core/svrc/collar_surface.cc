@@ -742,7 +742,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       for (size_t i = 0; i < params.size(); ++i) {
         const double a = params[i];
         const double b = i + 1 < params.size() ? params[i + 1] : params[0] + kTwoPi;
-        probes.push_back(std::fmod(0.5 * (a + b), kTwoPi));
+        probes.push_back(0.5 * (a + b));
       }
     } else {
       for (const Arc& arc : res.circle_arcs[k]) {
@@ -755,17 +755,17 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
         probes.push_back(0.5 * (a + arc.t1));
       }
     }
-    double best_t = 0, best_d = -1;
+    Vec3 best_x;
+    double best_d = -1;
     for (double t : probes) {
       const Vec3 x = CirclePoint(circle, std::fmod(t, kTwoPi));
       const double d = geom::Dist(x, dt.Point(dt.NearestVertex(x)));
       if (d > best_d) {
         best_d = d;
-        best_t = t;
+        best_x = x;
       }
     }
-    add(CirclePoint(circle, std::fmod(best_t, kTwoPi)), collars.circles[k].a, k,
-        CollarRepair::kCircle);
+    add(best_x, collars.circles[k].a, k, CollarRepair::kCircle);
   }
 
   // Angles (Definition 34, snapped) and sizes (Ch. 6).

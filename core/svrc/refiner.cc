@@ -258,6 +258,20 @@ class Refiner {
   // After a failed stitch: the representation points of T′ faces whose star
   // is inverted go in as COLLAR repairs (CD (3,2)); returns how many.
   absl::StatusOr<uint32_t> RepairStitchFailures();
+  // Consecutive collared points along each crease segment's M_s, in order:
+  // (segment, vertex u of M_s, the next collared vertex w, their balls).
+  struct CreaseBallPair {
+    uint32_t seg, u, w, ball_u, ball_w;
+  };
+  std::vector<CreaseBallPair> CreaseBallPairs() const;
+  // Cancellation and deadlines inside a Destroy's attempt loop, every 256
+  // attempts: a long yield chain never reaches Run()'s poll between events
+  // (measured: f_real/hinge.stl spent > 15 min in one DestroyFacet and
+  // ignored a 900 s deadline).
+  absl::Status PollInDestroy(int attempt) const {
+    if (attempt == 0 || attempt % 256 != 0 || !options_.poll) return absl::OkStatus();
+    return options_.poll();
+  }
   // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
   absl::Status Stitch() { return StitchImpl(); }
   void ClearStitch() {
@@ -1011,13 +1025,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy (facet) yielded without end");
-    // A long yield chain inside one Destroy never reaches Run()'s poll
-    // (measured: f_real/hinge.stl spent > 15 min in one DestroyFacet and
-    // ignored a 900 s deadline): cancellation and deadlines are polled here too.
-    if (attempt > 0 && attempt % 256 == 0 && options_.poll) {
-      absl::Status polled = options_.poll();
-      if (!polled.ok()) return polled;
-    }
+    if (absl::Status polled = PollInDestroy(attempt); !polled.ok()) return polled;
     // Each yield inserts into a segment mesh: the budget bounds the chain.
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached"));
@@ -1124,13 +1132,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy yielded without end");
-    // A long yield chain inside one Destroy never reaches Run()'s poll
-    // (measured: f_real/hinge.stl spent > 15 min in one DestroyFacet and
-    // ignored a 900 s deadline): cancellation and deadlines are polled here too.
-    if (attempt > 0 && attempt % 256 == 0 && options_.poll) {
-      absl::Status polled = options_.poll();
-      if (!polled.ok()) return polled;
-    }
+    if (absl::Status polled = PollInDestroy(attempt); !polled.ok()) return polled;
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached"));
     }
@@ -1629,41 +1631,50 @@ constexpr const char* kCollarRepairName[] = {"topology", "angle", "circle", "siz
 // Smallest RepBall accepted, relative to its collar ball's radius.
 constexpr double kMinCollarRepairRatio = 1e-4;
 
-absl::StatusOr<bool> Refiner::SplitCollarNecks() {
+std::vector<Refiner::CreaseBallPair> Refiner::CreaseBallPairs() const {
   std::vector<uint32_t> ball_of(points_.size(), CollarIndex::kNone);
   for (uint32_t i = 0; i < collar_centre_.size(); ++i) ball_of[collar_centre_[i].value()] = i;
-  bool any = false;
+  std::vector<CreaseBallPair> out;
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
     if (!complex_->segments[sg].crease) continue;
-    SegmentMesh& m = segs_[sg];
+    const SegmentMesh& m = segs_[sg];
     uint32_t prev = SegmentMesh::kNil;  // last vertex with a ball
     for (uint32_t u = 0; u != SegmentMesh::kNil; u = m.Next(u)) {
-      const PointId p = m.PointOf(u);
-      if (p.value() >= ball_of.size() || ball_of[p.value()] == CollarIndex::kNone) continue;
-      if (prev != SegmentMesh::kNil) {
-        const CollarBall& a = collars_.ball(ball_of[m.PointOf(prev).value()]);
-        const CollarBall& b = collars_.ball(ball_of[p.value()]);
-        const double d = geom::Dist(a.center, b.center);
-        if (d < a.radius + b.radius && d * d > a.radius * a.radius + b.radius * b.radius) {
-          // The crease point on the neck: where the circle's plane crosses
-          // the segment.
-          const double x = (d * d + a.radius * a.radius - b.radius * b.radius) / (2 * d);
-          const double t = m.T(prev) + (m.T(u) - m.T(prev)) * (x / d);
-          uint32_t w = prev;
-          while (m.Next(w) != u && m.T(m.Next(w)) <= t) w = m.Next(w);
-          if (t > m.T(w) && t < m.T(m.Next(w))) {
-            const uint32_t np = points_.size();
-            if (neck_point_.size() <= np) neck_point_.resize(np + 1024, 0);
-            neck_point_[np] = 1;
-            absl::Status st = ForceInsertSegment(sg, w, t, kCdSegment);
-            if (!st.ok()) return st;
-            ++stats_.neck_splits;
-            any = true;
-          }
-        }
-      }
+      // Crease points without a ball are inside a collar (CreateCollar skips
+      // them) or outside every collar.
+      const uint32_t b = ball_of[m.PointOf(u).value()];
+      if (b == CollarIndex::kNone) continue;
+      if (prev != SegmentMesh::kNil) out.push_back({sg, prev, u, ball_of[m.PointOf(prev).value()], b});
       prev = u;
     }
+  }
+  return out;
+}
+
+absl::StatusOr<bool> Refiner::SplitCollarNecks() {
+  bool any = false;
+  // Splitting a piece adds a vertex between u and w; the ids of the other
+  // pairs' vertices stay valid.
+  for (const CreaseBallPair& pr : CreaseBallPairs()) {
+    SegmentMesh& m = segs_[pr.seg];
+    const CollarBall& a = collars_.ball(pr.ball_u);
+    const CollarBall& b = collars_.ball(pr.ball_w);
+    const double d = geom::Dist(a.center, b.center);
+    if (!(d < a.radius + b.radius && d * d > a.radius * a.radius + b.radius * b.radius)) continue;
+    // The crease point on the neck: where the circle's plane crosses the
+    // segment.
+    const double x = (d * d + a.radius * a.radius - b.radius * b.radius) / (2 * d);
+    const double t = m.T(pr.u) + (m.T(pr.w) - m.T(pr.u)) * (x / d);
+    uint32_t v = pr.u;
+    while (m.Next(v) != pr.w && m.T(m.Next(v)) <= t) v = m.Next(v);
+    if (!(t > m.T(v) && t < m.T(m.Next(v)))) continue;
+    const uint32_t np = points_.size();
+    if (neck_point_.size() <= np) neck_point_.resize(np + 1024, 0);
+    neck_point_[np] = 1;
+    absl::Status st = ForceInsertSegment(pr.seg, v, t, kCdSegment);
+    if (!st.ok()) return st;
+    ++stats_.neck_splits;
+    any = true;
   }
   return any;
 }
@@ -1948,29 +1959,17 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
 absl::Status Refiner::StitchImpl() {
   const delaunay::Delaunay3& dt = omega_.dt();
   std::vector<StitchBall> balls(collars_.size());
-  std::vector<uint32_t> ball_of_point(points_.size(), CollarIndex::kNone);
   for (uint32_t i = 0; i < collars_.size(); ++i) {
-    const PointId p = collar_centre_[i];
     balls[i].ball = collars_.ball(i);
-    balls[i].centre = VertexId(points_.VertexIn(p, kOmegaMesh));
-    ball_of_point[p.value()] = i;
+    balls[i].centre = VertexId(points_.VertexIn(collar_centre_[i], kOmegaMesh));
   }
   // Crease edges: consecutive collared points along each crease segment.
+  // Crease points without a ball between them lie on the book's axis and are
+  // removed with the inside; those outside every collar break no pair whose
+  // spheres cross (the stitch ignores pairs that do not cross).
   std::vector<std::pair<uint32_t, uint32_t>> edges;
-  for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
-    if (!complex_->segments[sg].crease) continue;
-    const SegmentMesh& m = segs_[sg];
-    uint32_t prev = CollarIndex::kNone;
-    for (uint32_t v = 0; v != SegmentMesh::kNil; v = m.Next(v)) {
-      const uint32_t b = ball_of_point[m.PointOf(v).value()];
-      // Crease points without a ball are inside a collar (CreateCollar skips
-      // them) or outside every collar; the first lie on the book's axis and
-      // are removed with the inside, the second break no pair whose spheres
-      // cross (the stitch ignores pairs that do not cross).
-      if (b == CollarIndex::kNone) continue;
-      if (prev != CollarIndex::kNone) edges.emplace_back(std::min(prev, b), std::max(prev, b));
-      prev = b;
-    }
+  for (const CreaseBallPair& pr : CreaseBallPairs()) {
+    edges.emplace_back(std::min(pr.ball_u, pr.ball_w), std::max(pr.ball_u, pr.ball_w));
   }
   StitchInput in;
   in.dt = &dt;
