@@ -1,6 +1,7 @@
 #include "core/plc/families.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -307,6 +308,15 @@ Plc FacetFan(int k, double spacing_deg) {
     dirs.push_back({std::cos(a), 0, std::sin(a)});
   }
   HingeQuads(b, 0.5, 0.5, dirs, 0.4);
+  return b.Take();
+}
+
+Plc FlatTetrahedron() {
+  Builder b("flat_tetrahedron");
+  const uint32_t v[4] = {b.V(0, 0, 0), b.V(1, 0, 0), b.V(0.5, 0.9, 0), b.V(0.5, 0.3, 0.15)};
+  for (const auto& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}}) {
+    b.Face({v[t[0]], v[t[1]], v[t[2]]}, 0);
+  }
   return b.Take();
 }
 

@@ -99,6 +99,12 @@ Plc SegmentFacetAngle(double angle_deg);
 // smallest dihedral at the hinge is min(spacing, 360 - (k-1)*spacing).
 Plc FacetFan(int k, double spacing_deg);
 
+// The tetrahedron (0,0,0), (1,0,0), (1/2,9/10,0), (1/2,3/10,3/20): its side
+// facets meet the base at ~26.6°, so all three base edges are creases below
+// 45° and its collar system needs neck splits (docs/svrc-collars.md,
+// "Wiring status (session 5)"). Not in StandardInputs().
+Plc FlatTetrahedron();
+
 // A generated input with what a benchmark should do with it.
 struct GeneratedInput {
   std::string name;         // file-name friendly, e.g. "crease_pair_5deg"

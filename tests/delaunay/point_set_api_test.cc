@@ -3,12 +3,12 @@
 // refused (never a convex-hull mesh).
 #include <gtest/gtest.h>
 
-#include <array>
 #include <random>
 
 #include "core/api.h"
 #include "core/geometry/predicates.h"
 #include "core/mesh/canonical.h"
+#include "core/plc/families.h"
 #include "tests/delaunay/tet_check.h"
 
 namespace svrc::core {
@@ -103,16 +103,9 @@ TEST(MeshPlcPointSetTest, ProgressAndCancel) {
 // crease, in well under a second. A lone triangle encloses no volume:
 // INVALID_ARGUMENT.
 TEST(MeshPlcPointSetTest, PlcWithCreasesIsRefusedNamingTheCrease) {
-  plc::Plc p;
-  p.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 0.15}};
-  for (std::array<uint32_t, 3> t : {std::array<uint32_t, 3>{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}}) {
-    plc::Facet f;
-    f.polygons.push_back(plc::Polygon{{t[0], t[1], t[2]}});
-    p.facets.push_back(f);
-  }
   MeshParams capped;
   capped.max_vertices = 3000;
-  auto m = MeshPlc(p, capped);
+  auto m = MeshPlc(plc::families::FlatTetrahedron(), capped);
   ASSERT_FALSE(m.ok());
   EXPECT_EQ(m.status().code(), absl::StatusCode::kFailedPrecondition) << m.status();
   EXPECT_NE(m.status().message().find("crease"), std::string::npos) << m.status();

@@ -5,7 +5,6 @@
 // not touch a crease. Inputs the collar stage cannot finish yet must end
 // FAILED_PRECONDITION naming a crease, fast (docs/svrc-collars.md).
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <set>
 #include <string>
@@ -250,14 +249,7 @@ TEST(CreaseMesh, FlatTetrahedron) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
 #endif
-  plc::Plc flat;
-  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 0.9, 0}, {0.5, 0.3, 0.15}};
-  for (std::array<uint32_t, 3> t : {std::array<uint32_t, 3>{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}}) {
-    plc::Facet f;
-    f.polygons.push_back(plc::Polygon{{t[0], t[1], t[2]}});
-    flat.facets.push_back(f);
-  }
-  MeshAndCheck(flat, "flat tetrahedron");
+  MeshAndCheck(plc::families::FlatTetrahedron(), "flat tetrahedron");
 }
 
 }  // namespace
