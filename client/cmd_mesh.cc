@@ -3,10 +3,12 @@
 // output is byte-identical to this command's for the same input and flags.
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/mesh/quality.h"
+#include "core/mesh/stats_payload.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "client/cli_util.h"
@@ -68,6 +70,13 @@ int RunMesh(const std::vector<std::string>& argv) {
       &cancel);
   printer.Done();
   if (!mesh.ok()) {
+    // A failed run's counters come with its status (core/mesh/stats_payload.h).
+    if (args->switches.count("--stats")) {
+      if (std::optional<mesh::MeshStats> partial = mesh::StatsOf(mesh.status()); partial.has_value()) {
+        std::printf("counters of the failed run:\n");
+        for (const auto& [name, value] : partial->counters) std::printf("  %-34s %.10g\n", name.c_str(), value);
+      }
+    }
     return Fail(ExitCodeFor(mesh.status(), true),
                 absl::StrCat(in, ": ", absl::StatusCodeToString(mesh.status().code()), ": ",
                              mesh.status().message()));

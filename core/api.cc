@@ -9,6 +9,7 @@
 #include "core/delaunay/point_set.h"
 #include "core/geometry/predicates.h"
 #include "core/mesh/conformity.h"
+#include "core/mesh/stats_payload.h"
 #include "core/plc/validate.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
@@ -203,15 +204,17 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
   if (!refined.ok()) {
     if (!crease.empty() && !use_collars && refined.status().code() == absl::StatusCode::kResourceExhausted) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "SVRC: ", crease, "; refinement without collars did not finish within ", options.max_vertices,
-          " vertices"));
+      return mesh::Rewrap(absl::StatusCode::kFailedPrecondition,
+                          absl::StrCat("SVRC: ", crease, "; refinement without collars did not finish within ",
+                                       options.max_vertices, " vertices"),
+                          refined.status());
     }
     if (use_collars && (refined.status().code() == absl::StatusCode::kResourceExhausted ||
                         refined.status().code() == absl::StatusCode::kFailedPrecondition)) {
-      return absl::FailedPreconditionError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
-                                                        " degrees): the collar stage did not finish: ",
-                                                        refined.status().message()));
+      return mesh::Rewrap(absl::StatusCode::kFailedPrecondition,
+                          absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
+                                       " degrees): the collar stage did not finish: ", refined.status().message()),
+                          refined.status());
     }
     return refined.status();
   }

@@ -14,7 +14,9 @@
 #include <optional>
 #include <tuple>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
+#include "core/mesh/stats_payload.h"
 #include "core/geometry/predicates.h"
 #include "core/plc/features.h"
 #include "core/plc/intersect.h"
@@ -90,6 +92,10 @@ class Refiner {
   absl::Status Run();
   absl::Status CheckInvariants(bool final);
   PointSetRefinement Output(std::span<const Vec3> input);
+  // The counters Output() reports, except the per-vertex scans (max degree,
+  // max aspect): also for a run that fails (attached to its status).
+  void FillCounters(RefineStats* out) const;
+  const RefineStats& stats() const { return stats_; }
   // The facts the output stage relies on, checked on the final meshes: every
   // segment piece is an edge and every in-facet triangle a face of M_Ω, all
   // their vertices in M_Ω. INTERNAL naming the first failure.
@@ -1023,6 +1029,21 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
   FacetMesh& m = facets_[f];
   const MeshId mesh = FacetMeshId(f);
   const double theta_r2 = (options_.theta * r) * (options_.theta * r);
+  // Destroying a triangle, the disk whose interior points destroy it is its
+  // circumdisk. DestroyBall clamps a circumcentre outside Ω_F into the square
+  // and shrinks r, so (c, r) can be a small part of that disk, while a
+  // straddled piece is split towards its crossing anywhere in the triangle.
+  // Warps are tested against the whole circumdisk (measured: f_real/hinge.stl,
+  // facet 459, a triangle of side 2.4 clamped to r = 0.40: its crossing
+  // segment was halved uniformly for 100,000 yields, every new point outside
+  // the clamped disk, for minutes).
+  Vec2 wc = c;
+  double wr2 = r * r;
+  if (tri.valid()) {
+    wc = m.dt().Circumcenter(tri);
+    const double wr = m.dt().Circumradius(tri);
+    wr2 = wr * wr;
+  }
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy (facet) yielded without end");
     if (absl::Status polled = PollInDestroy(attempt); !polled.ok()) return polled;
@@ -1049,7 +1070,9 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
         // point falls inside the triangle; with θr, a crossing near the
         // disk's rim was never reached (halving to the last ulp; measured
         // on knife_edge.poly refined through its creases).
-        if (d2 > (tri.valid() ? r * r * (1 - 1e-9) : theta_r2)) continue;
+        if (tri.valid() ? (q.x - wc.x) * (q.x - wc.x) + (q.y - wc.y) * (q.y - wc.y) > wr2 * (1 - 1e-9) : d2 > theta_r2) {
+          continue;
+        }
         if (PreferWarp(b, d2, warp, warp_d2)) {
           warp = b;
           warp_d2 = d2;
@@ -1097,6 +1120,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
       return ForceInsertFacet(f, p, cj, hint);
     }
     ++stats_.yields;
+    stats_.max_yield_chain = std::max<uint64_t>(stats_.max_yield_chain, attempt + 1);
     absl::Status st = DestroySegmentPiece(piece_seg_[yield.value()], piece_vertex_[yield.value()]);
     if (!st.ok()) return st;
   }
@@ -1192,6 +1216,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     // start over: the new segment point may now be a warp target. M_Ω did not
     // change, so the gap ball is still ours.
     ++stats_.yields;
+    stats_.max_yield_chain = std::max<uint64_t>(stats_.max_yield_chain, attempt + 1);
     absl::Status st = DestroyBall(yield);
     if (!st.ok()) return st;
   }
@@ -2390,6 +2415,38 @@ absl::Status Refiner::VerifyConformity() const {
   return absl::OkStatus();
 }
 
+void Refiner::FillCounters(RefineStats* out) const {
+  RefineStats& st = *out;
+  st.vertices = omega_.dt().NumVertices();
+  // Inputs in M_Ω: all but the duplicates at the end, fewer in a failed run.
+  st.input_vertices = 0;
+  for (uint32_t i = 0; i < num_input_; ++i) st.input_vertices += points_.InMesh(PointId(i), kOmegaMesh);
+  st.facet_vertices_in_omega = 0;
+  for (uint32_t i = 0; i < points_.size(); ++i) {
+    if (points_.CdOf(PointId(i)) == kCdFacet && points_.Parent(PointId(i)) != FeatureTable::Omega() &&
+        points_.InMesh(PointId(i), kOmegaMesh)) {
+      ++st.facet_vertices_in_omega;
+    }
+  }
+  // Segment points in M_Ω: all at the end (conformity), fewer in a failed run.
+  uint64_t segment_in_omega = 0;
+  for (uint32_t i = num_input_ + 8; i < points_.size(); ++i) {
+    segment_in_omega += points_.CdOf(PointId(i)).dim == 1 && points_.InMesh(PointId(i), kOmegaMesh);
+  }
+  st.steiner_vertices = st.vertices - 8 - st.input_vertices - segment_in_omega - st.facet_vertices_in_omega;
+  const WorkQueues::Stats& q = queues_.stats();
+  for (int i = 0; i < kNumEventTypes; ++i) {
+    st.events_pushed[i] = q.pushed[i];
+    st.events_popped[i] = q.popped[i];
+    st.events_stale[i] = q.stale[i];
+  }
+  st.buckets_walked = q.buckets_walked;
+  st.max_bucket_walk = q.max_walk_one_op;
+  st.links_added = blg_.stats().links_added;
+  st.links_removed = blg_.stats().links_removed;
+  st.clipped_cells = omega_.stats().clipped_queries;
+}
+
 PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   const delaunay::Delaunay3& dt = omega_.dt();
   PointSetRefinement out;
@@ -2473,26 +2530,7 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     for (const auto& [f, k] : StitchedFacetFaces()) out.facet_triangles[f].push_back(k);
   }
   RefineStats& st = stats_;
-  st.vertices = dt.NumVertices();
-  st.input_vertices = num_input_ - st.duplicates;
-  for (uint32_t i = 0; i < points_.size(); ++i) {
-    if (points_.CdOf(PointId(i)) == kCdFacet && points_.Parent(PointId(i)) != FeatureTable::Omega() &&
-        points_.InMesh(PointId(i), kOmegaMesh)) {
-      ++st.facet_vertices_in_omega;
-    }
-  }
-  st.steiner_vertices = st.vertices - 8 - st.input_vertices - st.segment_vertices - st.facet_vertices_in_omega;
-  const WorkQueues::Stats& q = queues_.stats();
-  for (int i = 0; i < kNumEventTypes; ++i) {
-    st.events_pushed[i] = q.pushed[i];
-    st.events_popped[i] = q.popped[i];
-    st.events_stale[i] = q.stale[i];
-  }
-  st.buckets_walked = q.buckets_walked;
-  st.max_bucket_walk = q.max_walk_one_op;
-  st.links_added = blg_.stats().links_added;
-  st.links_removed = blg_.stats().links_removed;
-  st.clipped_cells = omega_.stats().clipped_queries;
+  FillCounters(&st);
   std::vector<VertexId> nbrs;
   for (uint32_t w = 0; w < dt.NumVertices(); ++w) {
     dt.Neighbors(VertexId(w), &nbrs);
@@ -2517,6 +2555,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.insertions", static_cast<double>(insertions));
   out->Set("svrc.warps", static_cast<double>(warps));
   out->Set("svrc.yields", static_cast<double>(yields));
+  out->Set("svrc.max_yield_chain", static_cast<double>(max_yield_chain));
   for (int i = 0; i < 4; ++i) {
     out->Set(absl::StrCat("svrc.events_pushed.", kTypes[i]), static_cast<double>(events_pushed[i]));
     out->Set(absl::StrCat("svrc.events_popped.", kTypes[i]), static_cast<double>(events_popped[i]));
@@ -2594,7 +2633,28 @@ absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const Vec3>
   return refiner.Output(points);
 }
 
+namespace {
+absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& complex, const RefineOptions& options,
+                                                 RefineStats* counters);
+}  // namespace
+
 absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex, const RefineOptions& options) {
+  RefineStats counters;
+  counters.seconds = -1;  // no refiner was built
+  absl::StatusOr<PointSetRefinement> out = RefinePlcImpl(complex, options, &counters);
+  if (!out.ok() && counters.seconds >= 0) {
+    mesh::MeshStats stats;
+    counters.ExportTo(&stats);
+    absl::Status st = out.status();
+    mesh::AttachStats(stats, &st);
+    return st;
+  }
+  return out;
+}
+
+namespace {
+absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& complex, const RefineOptions& options,
+                                                 RefineStats* counters) {
   if (!(options.tau > 0) || !(options.theta > 0 && options.theta < 1)) {
     return absl::InvalidArgumentError("SVRC: need tau > 0 and 0 < theta < 1");
   }
@@ -2623,6 +2683,15 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   absl::StatusOr<NormalisedInput> in = NormaliseInput(input);
   if (!in.ok()) return in.status();
   Refiner refiner(options, in->norm, in->center, in->half);
+  // On every exit: how far the run got (RefinePlc attaches it to a failure).
+  absl::Cleanup report_counters = [&] {
+    *counters = refiner.stats();
+    refiner.FillCounters(counters);
+    counters->collar_rounds = refiner.collar_rounds_;
+    counters->collar_repairs = refiner.collar_repairs_;
+    counters->arc_repairs = refiner.arc_repairs_;
+    counters->seconds = std::max(0.0, counters->seconds);
+  };
   absl::Status s = refiner.Setup(complex, in->points);
   if (!s.ok()) return s;
   s = refiner.Run();
@@ -2754,6 +2823,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
   out.stats.collar_worst_smoothness = sm.worst;
   return out;
 }
+}  // namespace
 
 std::vector<ConstrainedFace> ConstrainedFacesOf(const PointSetRefinement& refined,
                                                 const plc::FeatureComplex& complex) {

@@ -92,11 +92,12 @@ struct RefineStats {
   uint64_t insertions = 0;
   uint64_t warps = 0;              // Destroy line 6
   uint64_t yields = 0;             // Destroy line 13
+  uint64_t max_yield_chain = 0;    // the most yields in one Destroy
   uint64_t duplicates = 0;         // warp targets equal to an existing vertex
   uint64_t phantom_corners = 0;    // clipped cell corners equal to an existing vertex (skipped)
-  uint64_t tied_balls = 0;
-  uint64_t straddle_yields = 0;
-  uint64_t size_rounds = 0;
+  uint64_t tied_balls = 0;         // pieces/triangles missing at the end (ties), re-enqueued
+  uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first
+  uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run
   uint64_t collars = 0;            // collar balls created (stage (d))
   uint64_t vertex_collars = 0;     // of those, centred on an input vertex
   uint64_t collars_skipped_inside = 0;  // crease points strictly inside a collar: no ball
@@ -110,8 +111,8 @@ struct RefineStats {
   uint64_t collar_pairs_not_smooth = 0;  // of those, meeting below π/2 (Lemma 14)
   double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
-  uint64_t arc_repairs = 0;        // points inserted on facet arcs      // pieces/triangles inside collars left to RipStitchCollar
-  uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end        // max_volume: label + size-event rounds run    // facet triangles crossing a piece: the piece split first         // pieces/triangles missing at the end (ties), re-enqueued
+  uint64_t arc_repairs = 0;        // points inserted on facet arcs
+  uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
