@@ -190,6 +190,7 @@ int RunGet(const std::vector<std::string>& argv) {
                 static_cast<unsigned long long>(p.queue_size()), p.elapsed_seconds(),
                 job->input_name().c_str());
     if (job->has_error()) std::printf("error %s\n", StatusLine(job->error()).c_str());
+    for (const v1::Counter& c : job->failure_stats()) std::printf("  %-34s %.10g\n", c.name().c_str(), c.value());
     if (job->state() == v1::SUCCEEDED) PrintSummary(*job);
     return kExitOk;
   }

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdlib>
 #include <mutex>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/codec/container.h"
+#include "core/mesh/stats_payload.h"
 #include "core/plc/readers.h"
 #include "google/protobuf/util/time_util.h"
 #include "proto/convert.h"
@@ -381,7 +383,17 @@ void JobManager::Finish(JobRecord* rec, const absl::Status& status) {
   }
   job.set_state(StateFor(status));
   if (status.ok()) job.mutable_progress()->set_phase("done");
-  if (!status.ok()) *job.mutable_error() = ToProtoStatus(status);
+  if (!status.ok()) {
+    *job.mutable_error() = ToProtoStatus(status);
+    // How far the mesher got (core/mesh/stats_payload.h).
+    if (const std::optional<mesh::MeshStats> partial = mesh::StatsOf(status); partial.has_value()) {
+      for (const auto& [name, value] : partial->counters) {
+        v1::Counter* c = job.add_failure_stats();
+        c->set_name(name);
+        c->set_value(value);
+      }
+    }
+  }
   rec->ended = absl::Now();
   *job.mutable_end_time() = ToTimestamp(rec->ended);
   rec->request.Clear();

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -282,6 +283,35 @@ TEST(ServiceTest, BrokenPlcIsInvalidArgumentNamingTheProblem) {
   EXPECT_NE(done->error().message().find("bad_dangling_index.poly"), std::string::npos)
       << done->error().message();
   EXPECT_NE(done->error().message().find("42"), std::string::npos) << done->error().message();
+}
+
+// A job that runs out of budget tells how far it got: the mesher's counters
+// ride on its status (core/mesh/stats_payload.h) into Job.failure_stats.
+TEST(ServiceTest, FailedPlcJobCarriesTheMeshersCounters) {
+  ServerProcess server;
+  ASSERT_TRUE(server.ok());
+  RemoteClient c(server.address());
+  absl::StatusOr<v1::SubmitJobRequest> r = cli::RequestForFile(testing::CorpusPath("a_convex/cube.poly"));
+  ASSERT_TRUE(r.ok()) << r.status();
+  r->mutable_parameters()->set_max_volume(1e-6);  // ~10^6 tets wanted
+  r->mutable_limits()->set_max_vertices(3000);
+  absl::StatusOr<v1::Job> job = c.Submit(*r);
+  ASSERT_TRUE(job.ok()) << job.status();
+  absl::StatusOr<v1::Job> done = c.Watch(job->job_id(), nullptr);
+  ASSERT_TRUE(done.ok());
+  EXPECT_EQ(done->state(), v1::FAILED);
+  EXPECT_EQ(done->error().code(), static_cast<int>(grpc::StatusCode::RESOURCE_EXHAUSTED)) << done->error().message();
+  std::map<std::string, double> counters;
+  for (const v1::Counter& k : done->failure_stats()) counters[k.name()] = k.value();
+  ASSERT_TRUE(counters.count("svrc.vertices")) << done->failure_stats_size() << " counters";
+  EXPECT_GT(counters["svrc.vertices"], 8);  // more than Ω's corners
+  EXPECT_LE(counters["svrc.vertices"], 3000);
+  EXPECT_EQ(counters["svrc.vertices_dim0"], 8);  // the cube's corners are in M_Ω
+  EXPECT_GT(counters["svrc.insertions"], 0);
+  // The same counters after a fetch of the job by id (kept with the job).
+  absl::StatusOr<v1::Job> again = c.Get(job->job_id());
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->failure_stats_size(), done->failure_stats_size());
 }
 
 TEST(ServiceTest, PlcJobSucceedsOrIsUnimplementedNeverAnythingElse) {
