@@ -261,6 +261,9 @@ class Refiner {
   // π/2 get a crease point between them (the thesis' encroachment of the
   // piece by the neck circle); returns whether any was inserted.
   absl::StatusOr<bool> SplitCollarNecks();
+  // RefineOptions::early_crease_vertices: every crease input vertex (not a
+  // duplicate) into M_Ω, in input order, each with its collar.
+  absl::Status InsertCreaseVertices();
   // After a failed stitch: the representation points of T′ faces whose star
   // is inverted go in as COLLAR repairs (CD (3,2)); returns how many.
   absl::StatusOr<uint32_t> RepairStitchFailures();
@@ -1223,6 +1226,19 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
 }
 
 // ---------------------------------------------------------------- ForceInsert
+
+absl::Status Refiner::InsertCreaseVertices() {
+  TetId hint;
+  for (uint32_t i = 0; i < num_input_; ++i) {
+    const PointId p(i);
+    if (duplicate_of_[i] != i || !points_.IsCrease(p) || points_.InMesh(p, kOmegaMesh)) continue;
+    absl::Status st = ForceInsertOmega(p, hint);
+    if (!st.ok()) return st;
+    const uint32_t v = points_.VertexIn(p, kOmegaMesh);
+    if (v != PointStore::kNoVertex) hint = omega_.dt().VertexTet(VertexId(v));
+  }
+  return absl::OkStatus();
+}
 
 absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   delaunay::Delaunay3& dt = omega_.dt();
@@ -2430,8 +2446,15 @@ void Refiner::FillCounters(RefineStats* out) const {
   }
   // Segment points in M_Ω: all at the end (conformity), fewer in a failed run.
   uint64_t segment_in_omega = 0;
+  st.segment_vertices_in_collars = st.facet_vertices_in_collars = 0;
   for (uint32_t i = num_input_ + 8; i < points_.size(); ++i) {
-    segment_in_omega += points_.CdOf(PointId(i)).dim == 1 && points_.InMesh(PointId(i), kOmegaMesh);
+    const PointId p(i);
+    const int dim = points_.CdOf(p).dim;
+    segment_in_omega += dim == 1 && points_.InMesh(p, kOmegaMesh);
+    if (collars_.size() > 0 && (dim == 1 || dim == 2) && points_.Parent(p) != FeatureTable::Omega() &&
+        collars_.StrictlyInside(points_.Xyz(p))) {
+      ++(dim == 1 ? st.segment_vertices_in_collars : st.facet_vertices_in_collars);
+    }
   }
   st.steiner_vertices = st.vertices - 8 - st.input_vertices - segment_in_omega - st.facet_vertices_in_omega;
   const WorkQueues::Stats& q = queues_.stats();
@@ -2551,6 +2574,10 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.vertices_dim1", static_cast<double>(segment_vertices));
   out->Set("svrc.vertices_dim2", static_cast<double>(facet_vertices_in_omega));
   out->Set("svrc.facet_mesh_vertices", static_cast<double>(facet_vertices));
+  if (collars > 0) {
+    out->Set("svrc.segment_vertices_in_collars", static_cast<double>(segment_vertices_in_collars));
+    out->Set("svrc.facet_vertices_in_collars", static_cast<double>(facet_vertices_in_collars));
+  }
   out->Set("svrc.vertices_dim3", static_cast<double>(steiner_vertices));
   out->Set("svrc.insertions", static_cast<double>(insertions));
   out->Set("svrc.warps", static_cast<double>(warps));
@@ -2694,6 +2721,10 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   };
   absl::Status s = refiner.Setup(complex, in->points);
   if (!s.ok()) return s;
+  if (options.collars && options.early_crease_vertices) {
+    s = refiner.InsertCreaseVertices();
+    if (!s.ok()) return s;
+  }
   s = refiner.Run();
   if (!s.ok()) return s;
   // Size events (max_volume): label the conforming mesh, enqueue the cells

@@ -68,6 +68,16 @@ struct RefineOptions {
   // (measured: the flat tetrahedron meshes only with it; docs/svrc-collars.md
   // "Wiring status (session 5)").
   bool split_necks = true;
+  // Crease input vertices enter M_Ω before the queues run, each getting its
+  // collar at once (CreateCollar; g(v) is a property of the PLC, so the ball
+  // is the one a later warp would give). The thesis needs crease points
+  // "inserted in time" (§3.1.2, Lemma 23; Figure 3.9 triggers CreateCollar
+  // for isolated θ₀-medial crease points): with Figure 3.11's order M_Ω is
+  // refined last, so without this the facet meshes refine around sharp facet
+  // corners before any collar exists. Off by default: measured (docs/
+  // svrc-collars.md "Session 6"), it cuts hinge.stl's in-collar feature-mesh
+  // points 6.5× but not its size, and knife_edge grows 5,268 → 7,304 tets.
+  bool early_crease_vertices = false;
   // Snap band of facet arcs, relative to the circle radius (thesis δ, §3.1.2).
   double arc_snap = 0.02;
   // σ: the largest representation angle of the collar surface (radians;
@@ -88,6 +98,10 @@ struct RefineStats {
   uint64_t steiner_vertices = 0;   // created in M_Ω (dimension 3), corners excluded
   uint64_t segment_vertices = 0;   // created in segment meshes (dimension 1)
   uint64_t facet_vertices = 0;     // created in facet meshes (dimension 2), in F or not
+  // Where the feature-mesh work went (collars only): created segment and
+  // facet points strictly inside a collar ball at the end of the run.
+  uint64_t segment_vertices_in_collars = 0;
+  uint64_t facet_vertices_in_collars = 0;
   uint64_t facet_vertices_in_omega = 0;  // of those, in M_Ω at the end (inside their facet)
   uint64_t insertions = 0;
   uint64_t warps = 0;              // Destroy line 6

@@ -195,6 +195,37 @@ TEST(CollarRefine, CorpusCreases) {
   }
 }
 
+// RefineOptions::early_crease_vertices: crease input vertices enter M_Ω
+// before the queues run, so FastCollarSize searches an almost empty M_Ω whose
+// cells carry many links. g(v) is a property of the PLC, so every vertex
+// collar must come out bit-identical to the one a later warp creates, and
+// every collar must still match the brute-force g/3.
+TEST(CollarRefine, EarlyCreaseVerticesGiveTheSameVertexCollars) {
+  for (const char* rel : {"c_creases/knife_edge.poly", "a_convex/tetra.poly"}) {
+    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(rel));
+    ASSERT_TRUE(plc.ok()) << rel << ": " << plc.status();
+    std::map<uint32_t, double> radius[2];
+    for (int early = 0; early < 2; ++early) {
+      CollarRun run;
+      absl::StatusOr<plc::FeatureComplex> c = plc::BuildFeatureComplex(*plc);
+      ASSERT_TRUE(c.ok()) << c.status();
+      run.complex = std::move(*c);
+      RefineOptions opt;
+      opt.collars = true;
+      opt.max_vertices = 2000000;
+      opt.early_crease_vertices = early == 1;
+      run.refined = RefinePlc(run.complex, opt);
+      CheckCollars(run, std::string(rel) + (early ? " early" : " late"));
+      if (!run.refined.ok()) return;
+      for (const auto& k : run.refined->collars) {
+        if (k.feature_dim == 0) radius[early][k.feature] = k.radius;
+      }
+    }
+    EXPECT_FALSE(radius[0].empty()) << rel;
+    EXPECT_EQ(radius[0], radius[1]) << rel;
+  }
+}
+
 TEST(CollarRefineDebug, One) {
   const char* a = getenv("SVRC_ANGLE");
   if (!a) GTEST_SKIP();
