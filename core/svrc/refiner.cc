@@ -371,7 +371,10 @@ class Refiner {
     return IsSkinny(s) || (v.value() < size_target_.size() && s.outradius > size_target_[v.value()]);
   }
   bool IsSkinny(const SegmentMesh::Size1& s) const { return s.outradius > options_.tau * s.inradius; }
-  bool IsSkinny(const CellSize2& s) const { return s.outradius > options_.tau * s.inradius; }
+  // Facet meshes: Voronoi aspect bound facet_tau_factor·τ (RefineOptions).
+  bool IsSkinny(const CellSize2& s) const {
+    return s.outradius > options_.facet_tau_factor * options_.tau * s.inradius;
+  }
 
   bool IsOmega(MeshId m) const { return m == kOmegaMesh; }
   bool IsSegMesh(MeshId m) const { return !segs_.empty() && m.value() >= seg_mesh0_ && m.value() < seg_mesh0_ + segs_.size(); }

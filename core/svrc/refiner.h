@@ -29,6 +29,15 @@ struct RefineOptions {
   double tau = 4.0;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
+  // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
+  // τ bounds the output tets; a facet mesh's quality sets how densely the
+  // facet is sampled before M_Ω asks for more (its Encroached/Unresolved
+  // events still split facet triangles where the tets need it), and any
+  // constant keeps the feature mesh well-spaced (bounded ply). 2 measured
+  // (docs/svrc-collars.md "Session 6"): crease_pair 30°/10°/5°/1° −25/−26/
+  // −22/−10% tets, knife_edge −17%, hinge.stl's facet meshes −43% at a
+  // 100,000-vertex budget; volume inputs unchanged (cube 1e-4 −0.7%).
+  double facet_tau_factor = 2.0;
   // Vertex budget of M_Ω (corners, inputs and Steiner points); 0: derived,
   // max(10^6, 1000·n). Exceeding it returns RESOURCE_EXHAUSTED.
   uint64_t max_vertices = 0;
@@ -220,7 +229,8 @@ absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const geom:
 // FAILED_PRECONDITION naming the first one: they need collars (issue #6).
 // Otherwise as RefinePointsAndSegments, plus: every in-facet triangle of
 // every facet mesh is a face of the output tets (`facet_triangles`), every
-// facet-mesh and segment-mesh cell is τ-well-spaced. Position i < number of
+// segment-mesh cell is τ-well-spaced and every facet-mesh cell
+// (facet_tau_factor·τ)-well-spaced. Position i < number of
 // complex points is complex point i (input coordinates, bit-exact).
 absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
                                              const RefineOptions& options);
