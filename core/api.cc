@@ -281,10 +281,12 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     report("check", mesh.positions.size(), 0, 0);
     const mesh::ConformityReport check = mesh::CheckConformity(plc, mesh);
     if (!check.ok()) {
-      return absl::FailedPreconditionError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
-                                                        " degrees): the stitched mesh next to the creases does not "
-                                                        "conform: ",
-                                                        check.Summary()));
+      absl::Status st = absl::FailedPreconditionError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
+                                                                   " degrees): the stitched mesh next to the creases "
+                                                                   "does not conform: ",
+                                                                   check.Summary()));
+      mesh::AttachStats(stats, &st);
+      return st;
     }
     // max_volume inside the collars: the stitched stars and books are not
     // refined by size events (the points inside are removed), so a collar
