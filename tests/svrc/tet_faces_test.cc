@@ -10,38 +10,23 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "tests/svrc/output_test_util.h"
 
 namespace svrc::refine {
 namespace {
 
 using Tet = std::array<uint32_t, 4>;
 
-// Kuhn's 6 tets per cube of an n×n×n grid, vertex ids shuffled so buckets
-// mix faces from far-apart tets.
+// Kuhn's 6 tets per cube of an n×n×n grid (testing::KuhnGrid), vertex ids
+// shuffled so buckets mix faces from far-apart tets.
 std::vector<Tet> GridTets(int n, uint32_t* num_vertices) {
-  const int m = n + 1;
-  std::vector<uint32_t> id(m * m * m);
+  const testing::Grid grid = testing::KuhnGrid(n);
+  std::vector<uint32_t> id(grid.positions.size());
   for (uint32_t i = 0; i < id.size(); ++i) id[i] = i;
   std::shuffle(id.begin(), id.end(), std::mt19937(7));
-  auto v = [&](int x, int y, int z) { return id[(z * m + y) * m + x]; };
   std::vector<Tet> tets;
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int z = 0; z < n; ++z) {
-    for (int y = 0; y < n; ++y) {
-      for (int x = 0; x < n; ++x) {
-        for (const auto& p : perms) {
-          int c[3] = {x, y, z};
-          Tet t;
-          t[0] = v(c[0], c[1], c[2]);
-          for (int k = 0; k < 3; ++k) {
-            ++c[p[k]];
-            t[k + 1] = v(c[0], c[1], c[2]);
-          }
-          tets.push_back(t);
-        }
-      }
-    }
-  }
+  tets.reserve(grid.tets.size());
+  for (const Tet& t : grid.tets) tets.push_back({id[t[0]], id[t[1]], id[t[2]], id[t[3]]});
   *num_vertices = static_cast<uint32_t>(id.size());
   return tets;
 }
