@@ -30,6 +30,11 @@ const Command kMesh{
     &RunMesh};
 const RegisterCommand kRegister{kMesh};
 
+// --stats: one "  name value" line per counter, in the mesher's order.
+void PrintCounters(const mesh::MeshStats& stats) {
+  for (const auto& [name, value] : stats.counters) std::printf("  %-34s %.10g\n", name.c_str(), value);
+}
+
 int RunMesh(const std::vector<std::string>& argv) {
   std::vector<std::string> values = MeshValueFlags();
   values.push_back("-o");
@@ -74,7 +79,7 @@ int RunMesh(const std::vector<std::string>& argv) {
     if (args->switches.count("--stats")) {
       if (std::optional<mesh::MeshStats> partial = mesh::StatsOf(mesh.status()); partial.has_value()) {
         std::printf("counters of the failed run:\n");
-        for (const auto& [name, value] : partial->counters) std::printf("  %-34s %.10g\n", name.c_str(), value);
+        PrintCounters(*partial);
       }
     }
     return Fail(ExitCodeFor(mesh.status(), true),
@@ -99,7 +104,7 @@ int RunMesh(const std::vector<std::string>& argv) {
   std::printf("wrote %s: %zu vertices, %zu tets, %zu boundary triangles in %.3f s\n", out.c_str(),
               mesh->num_vertices(), mesh->num_tets(), mesh->triangles.size(), seconds);
   if (args->switches.count("--stats")) {
-    for (const auto& [name, value] : mesh->stats.counters) std::printf("  %-34s %.10g\n", name.c_str(), value);
+    PrintCounters(mesh->stats);
     std::fputs(mesh::FormatQualityReport(mesh::ComputeQuality(*mesh)).c_str(), stdout);
   }
   return kExitOk;

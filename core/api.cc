@@ -192,6 +192,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   const std::string crease = FirstCrease(*complex, &sharpest);
   constexpr double kCollarAngleDeg = 45;
   const bool use_collars = !crease.empty() && sharpest < kCollarAngleDeg;
+  // The head of every collar-stage error: the crease and its angle.
+  const std::string crease_head = absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest, " degrees): ");
   if (use_collars) {
     options.collars = true;
     options.collar_surface = true;
@@ -212,8 +214,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     if (use_collars && (refined.status().code() == absl::StatusCode::kResourceExhausted ||
                         refined.status().code() == absl::StatusCode::kFailedPrecondition)) {
       return mesh::Rewrap(absl::StatusCode::kFailedPrecondition,
-                          absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
-                                       " degrees): the collar stage did not finish: ", refined.status().message()),
+                          absl::StrCat(crease_head, "the collar stage did not finish: ", refined.status().message()),
                           refined.status());
     }
     return refined.status();
@@ -257,14 +258,12 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     // f_real/hinge.stl after the collar stage, 25 min: docs/svrc-collars.md
     // "Session 6"). Say so instead of blaming the input.
     if (out.status().code() == absl::StatusCode::kInvalidArgument && plc.holes.empty() && !complex->facets.empty()) {
-      mesh::MeshStats partial = stats;
       absl::Status st = use_collars
                             ? absl::FailedPreconditionError(absl::StrCat(
-                                  "SVRC: ", crease, " (sharpest ", sharpest, " degrees): the stitched mesh does not ",
-                                  "seal the facets: ", out.status().message()))
+                                  crease_head, "the stitched mesh does not seal the facets: ", out.status().message()))
                             : absl::InternalError(absl::StrCat("SVRC: the output mesh does not seal the facets of a ",
                                                                "closed PLC: ", out.status().message()));
-      mesh::AttachStats(partial, &st);
+      mesh::AttachStats(stats, &st);
       return st;
     }
     return out.status();
@@ -281,10 +280,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     report("check", mesh.positions.size(), 0, 0);
     const mesh::ConformityReport check = mesh::CheckConformity(plc, mesh);
     if (!check.ok()) {
-      absl::Status st = absl::FailedPreconditionError(absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest,
-                                                                   " degrees): the stitched mesh next to the creases "
-                                                                   "does not conform: ",
-                                                                   check.Summary()));
+      absl::Status st = absl::FailedPreconditionError(
+          absl::StrCat(crease_head, "the stitched mesh next to the creases does not conform: ", check.Summary()));
       mesh::AttachStats(stats, &st);
       return st;
     }
@@ -302,7 +299,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
       if (r >= 0 && mesh.regions[r].max_volume > 0) bound = std::min(bound, mesh.regions[r].max_volume);
       if (vol > bound * (1 + 1e-9)) {
         return absl::FailedPreconditionError(absl::StrCat(
-            "SVRC: ", crease, " (sharpest ", sharpest, " degrees): a tet of volume ", vol,
+            crease_head, "a tet of volume ", vol,
             " next to the creases exceeds max_volume ", bound, " (collar tets are not refined by size yet)"));
       }
     }

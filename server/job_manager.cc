@@ -56,6 +56,15 @@ v1::JobState StateFor(const absl::Status& status) {
   return v1::FAILED;
 }
 
+// The mesher's counters into a Job's repeated Counter field, in its order.
+void AddCounters(const mesh::MeshStats& stats, google::protobuf::RepeatedPtrField<v1::Counter>* out) {
+  for (const auto& [name, value] : stats.counters) {
+    v1::Counter* c = out->Add();
+    c->set_name(name);
+    c->set_value(value);
+  }
+}
+
 }  // namespace
 
 struct JobManager::JobRecord {
@@ -387,11 +396,7 @@ void JobManager::Finish(JobRecord* rec, const absl::Status& status) {
     *job.mutable_error() = ToProtoStatus(status);
     // How far the mesher got (core/mesh/stats_payload.h).
     if (const std::optional<mesh::MeshStats> partial = mesh::StatsOf(status); partial.has_value()) {
-      for (const auto& [name, value] : partial->counters) {
-        v1::Counter* c = job.add_failure_stats();
-        c->set_name(name);
-        c->set_value(value);
-      }
+      AddCounters(*partial, job.mutable_failure_stats());
     }
   }
   rec->ended = absl::Now();
@@ -556,11 +561,7 @@ absl::Status JobManager::Execute(JobRecord* rec, const v1::SubmitJobRequest& req
   info->set_num_tets(mesh->num_tets());
   info->set_num_triangles(mesh->triangles.size());
   info->set_max_position_error(report.max_position_error);
-  for (const auto& [name, value] : mesh->stats.counters) {
-    v1::Counter* c = info->add_stats();
-    c->set_name(name);
-    c->set_value(value);
-  }
+  AddCounters(mesh->stats, info->mutable_stats());
   *mesh = mesh::TetMesh();
   if (absl::Status s = rec->cancel.Check(); !s.ok()) return s;
   phase("store");

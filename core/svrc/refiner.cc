@@ -1042,13 +1042,14 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
   // Warps are tested against the whole circumdisk (measured: f_real/hinge.stl,
   // facet 459, a triangle of side 2.4 clamped to r = 0.40: its crossing
   // segment was halved uniformly for 100,000 yields, every new point outside
-  // the clamped disk, for minutes).
+  // the clamped disk, for minutes). Otherwise warp targets lie within θr
+  // of c.
   Vec2 wc = c;
-  double wr2 = r * r;
+  double warp_r2 = theta_r2;
   if (tri.valid()) {
     wc = m.dt().Circumcenter(tri);
     const double wr = m.dt().Circumradius(tri);
-    wr2 = wr * wr;
+    warp_r2 = wr * wr * (1 - 1e-9);
   }
   for (int attempt = 0;; ++attempt) {
     if (attempt > 100000) return absl::InternalError("SVRC: Destroy (facet) yielded without end");
@@ -1076,9 +1077,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
         // point falls inside the triangle; with θr, a crossing near the
         // disk's rim was never reached (halving to the last ulp; measured
         // on knife_edge.poly refined through its creases).
-        if (tri.valid() ? (q.x - wc.x) * (q.x - wc.x) + (q.y - wc.y) * (q.y - wc.y) > wr2 * (1 - 1e-9) : d2 > theta_r2) {
-          continue;
-        }
+        if ((q.x - wc.x) * (q.x - wc.x) + (q.y - wc.y) * (q.y - wc.y) > warp_r2) continue;
         if (PreferWarp(b, d2, warp, warp_d2)) {
           warp = b;
           warp_d2 = d2;
@@ -2440,25 +2439,23 @@ void Refiner::FillCounters(RefineStats* out) const {
   // Inputs in M_Ω: all but the duplicates at the end, fewer in a failed run.
   st.input_vertices = 0;
   for (uint32_t i = 0; i < num_input_; ++i) st.input_vertices += points_.InMesh(PointId(i), kOmegaMesh);
-  st.facet_vertices_in_omega = 0;
-  for (uint32_t i = 0; i < points_.size(); ++i) {
-    if (points_.CdOf(PointId(i)) == kCdFacet && points_.Parent(PointId(i)) != FeatureTable::Omega() &&
-        points_.InMesh(PointId(i), kOmegaMesh)) {
-      ++st.facet_vertices_in_omega;
-    }
-  }
-  // Segment points in M_Ω: all at the end (conformity), fewer in a failed run.
+  // Created points (after the inputs and Ω's corners). Segment points in M_Ω:
+  // all at the end (conformity), fewer in a failed run.
   uint64_t segment_in_omega = 0;
-  st.segment_vertices_in_collars = st.facet_vertices_in_collars = 0;
+  st.facet_vertices_in_omega = st.segment_vertices_in_collars = st.facet_vertices_in_collars = 0;
   for (uint32_t i = num_input_ + 8; i < points_.size(); ++i) {
     const PointId p(i);
-    const int dim = points_.CdOf(p).dim;
-    segment_in_omega += dim == 1 && points_.InMesh(p, kOmegaMesh);
-    if (collars_.size() > 0 && (dim == 1 || dim == 2) && points_.Parent(p) != FeatureTable::Omega() &&
-        collars_.StrictlyInside(points_.Xyz(p))) {
-      ++(dim == 1 ? st.segment_vertices_in_collars : st.facet_vertices_in_collars);
+    const Cd cd = points_.CdOf(p);
+    const bool on_feature = points_.Parent(p) != FeatureTable::Omega();
+    segment_in_omega += cd.dim == 1 && points_.InMesh(p, kOmegaMesh);
+    st.facet_vertices_in_omega += cd == kCdFacet && on_feature && points_.InMesh(p, kOmegaMesh);
+    if (collars_.size() > 0 && (cd.dim == 1 || cd.dim == 2) && on_feature && collars_.StrictlyInside(points_.Xyz(p))) {
+      ++(cd.dim == 1 ? st.segment_vertices_in_collars : st.facet_vertices_in_collars);
     }
   }
+  st.collar_rounds = collar_rounds_;
+  st.collar_repairs = collar_repairs_;
+  st.arc_repairs = arc_repairs_;
   st.steiner_vertices = st.vertices - 8 - st.input_vertices - segment_in_omega - st.facet_vertices_in_omega;
   const WorkQueues::Stats& q = queues_.stats();
   for (int i = 0; i < kNumEventTypes; ++i) {
@@ -2665,16 +2662,15 @@ absl::StatusOr<PointSetRefinement> RefinePointsAndSegments(std::span<const Vec3>
 
 namespace {
 absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& complex, const RefineOptions& options,
-                                                 RefineStats* counters);
+                                                 std::optional<RefineStats>* counters);
 }  // namespace
 
 absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex, const RefineOptions& options) {
-  RefineStats counters;
-  counters.seconds = -1;  // no refiner was built
+  std::optional<RefineStats> counters;  // set when a run failed after its refiner was built
   absl::StatusOr<PointSetRefinement> out = RefinePlcImpl(complex, options, &counters);
-  if (!out.ok() && counters.seconds >= 0) {
+  if (!out.ok() && counters.has_value()) {
     mesh::MeshStats stats;
-    counters.ExportTo(&stats);
+    counters->ExportTo(&stats);
     absl::Status st = out.status();
     mesh::AttachStats(stats, &st);
     return st;
@@ -2684,7 +2680,7 @@ absl::StatusOr<PointSetRefinement> RefinePlc(const plc::FeatureComplex& complex,
 
 namespace {
 absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& complex, const RefineOptions& options,
-                                                 RefineStats* counters) {
+                                                 std::optional<RefineStats>* counters) {
   if (!(options.tau > 0) || !(options.theta > 0 && options.theta < 1)) {
     return absl::InvalidArgumentError("SVRC: need tau > 0 and 0 < theta < 1");
   }
@@ -2713,14 +2709,12 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   absl::StatusOr<NormalisedInput> in = NormaliseInput(input);
   if (!in.ok()) return in.status();
   Refiner refiner(options, in->norm, in->center, in->half);
-  // On every exit: how far the run got (RefinePlc attaches it to a failure).
+  // On every failed exit: how far the run got (RefinePlc attaches it to the
+  // status). Cancelled on success, where Output() reports the counters.
   absl::Cleanup report_counters = [&] {
-    *counters = refiner.stats();
-    refiner.FillCounters(counters);
-    counters->collar_rounds = refiner.collar_rounds_;
-    counters->collar_repairs = refiner.collar_repairs_;
-    counters->arc_repairs = refiner.arc_repairs_;
-    counters->seconds = std::max(0.0, counters->seconds);
+    RefineStats st = refiner.stats();
+    refiner.FillCounters(&st);
+    *counters = st;
   };
   absl::Status s = refiner.Setup(complex, in->points);
   if (!s.ok()) return s;
@@ -2847,10 +2841,8 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   s = refiner.Run();
   if (!s.ok()) return s;
   }
+  std::move(report_counters).Cancel();
   PointSetRefinement out = refiner.Output(input);
-  out.stats.collar_rounds = refiner.collar_rounds_;
-  out.stats.collar_repairs = refiner.collar_repairs_;
-  out.stats.arc_repairs = refiner.arc_repairs_;
   const CollarIndex::Smoothness sm = refiner.collars().MeasureSmoothness();
   out.stats.collar_pairs = sm.intersecting;
   out.stats.collar_pairs_not_smooth = sm.not_smooth;
