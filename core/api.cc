@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
@@ -10,6 +12,7 @@
 #include "core/geometry/predicates.h"
 #include "core/mesh/conformity.h"
 #include "core/mesh/stats_payload.h"
+#include "core/mesh/writers.h"
 #include "core/plc/validate.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
@@ -278,8 +281,22 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     // shown per input (docs/svrc-collars.md), not proven for every PLC:
     // check it here and never return a mesh that does not conform.
     report("check", mesh.positions.size(), 0, 0);
-    const mesh::ConformityReport check = mesh::CheckConformity(plc, mesh);
+    // With keep_bounding_box the mesh fills Ω: its hull faces are boundary,
+    // not open, and the enclosed volume is the box's (before session 7 the
+    // check ran without this and refused every creased input with
+    // --keep-bounding-box: 66 "open faces" on knife_edge.poly).
+    mesh::ConformityOptions check_options;
+    check_options.keep_bounding_box = keep_box;
+    const mesh::ConformityReport check = mesh::CheckConformity(plc, mesh, check_options);
     if (!check.ok()) {
+      // Debugging aid for the collar stage (docs/svrc-collars.md): the
+      // refused mesh, written where SVRC_DUMP_NONCONFORMING points (any
+      // format of mesh::WriteMeshFile), so it can be studied without
+      // re-running a long job. Never set in production.
+      if (const char* dump = std::getenv("SVRC_DUMP_NONCONFORMING"); dump != nullptr && *dump != '\0') {
+        const absl::Status ws = mesh::WriteMeshFile(mesh, dump);
+        std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %s: %s\n", dump, ws.ok() ? "written" : ws.ToString().c_str());
+      }
       absl::Status st = absl::FailedPreconditionError(
           absl::StrCat(crease_head, "the stitched mesh next to the creases does not conform: ", check.Summary()));
       mesh::AttachStats(stats, &st);
