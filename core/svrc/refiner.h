@@ -135,6 +135,7 @@ struct RefineStats {
   double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
+  uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
