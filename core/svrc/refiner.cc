@@ -12,6 +12,8 @@
 #include <span>
 #include <map>
 #include <optional>
+#include <set>
+#include <string>
 #include <tuple>
 
 #include "absl/cleanup/cleanup.h"
@@ -261,6 +263,11 @@ class Refiner {
   // π/2 get a crease point between them (the thesis' encroachment of the
   // piece by the neck circle); returns whether any was inserted.
   absl::StatusOr<bool> SplitCollarNecks();
+  // SVRC_COLLAR_DEBUG, when the COLLAR rounds fail: the intersecting ball
+  // pairs meeting below π/2 (Lemma 14) by kind, the first consecutive ones
+  // with the segment vertices between them, and the worst 12, to stderr
+  // (docs/svrc-collars.md "Session 8").
+  void DebugNonSmoothPairs() const;
   // RefineOptions::early_crease_vertices: every crease input vertex (not a
   // duplicate) into M_Ω, in input order, each with its collar.
   absl::Status InsertCreaseVertices();
@@ -1725,6 +1732,80 @@ absl::StatusOr<bool> Refiner::SplitCollarNecks() {
   return any;
 }
 
+void Refiner::DebugNonSmoothPairs() const {
+  std::set<std::pair<uint32_t, uint32_t>> consecutive;
+  for (const CreaseBallPair& pr : CreaseBallPairs()) {
+    consecutive.insert({std::min(pr.ball_u, pr.ball_w), std::max(pr.ball_u, pr.ball_w)});
+  }
+  struct Bad {
+    double ratio;
+    uint32_t a, b;
+  };
+  std::vector<Bad> bad;
+  const uint32_t n = collars_.size();
+  for (uint32_t i = 0; i < n; ++i) {
+    const CollarBall& a = collars_.ball(i);
+    for (uint32_t j = i + 1; j < n; ++j) {
+      const CollarBall& b = collars_.ball(j);
+      const double d = geom::Dist(a.center, b.center);
+      if (d >= a.radius + b.radius || d <= std::fabs(a.radius - b.radius)) continue;
+      const double ratio = d * d / (a.radius * a.radius + b.radius * b.radius);
+      if (ratio > 1) bad.push_back({ratio, i, j});
+    }
+  }
+  // Kinds: "consecutive" = neighbours on a crease segment's chain (a neck
+  // split should have separated them); otherwise by the centres' features.
+  std::map<std::string, int> kinds;
+  auto kind_of = [&](const Bad& x) {
+    if (consecutive.count({x.a, x.b})) return std::string("consecutive on a crease segment");
+    const FeatureId fa = points_.Parent(collar_centre_[x.a]), fb = points_.Parent(collar_centre_[x.b]);
+    if (fa == fb) return absl::StrCat("same feature, dim ", features_.Dim(fa), ", not consecutive");
+    if (features_.Dim(fa) + features_.Dim(fb) == 1) {
+      const FeatureId fv = features_.Dim(fa) == 0 ? fa : fb, fs = features_.Dim(fa) == 0 ? fb : fa;
+      const plc::FeatureSegment& sg = complex_->segments[features_.Index(fs)];
+      const uint32_t vi = features_.Index(fv);
+      return absl::StrCat("vertex ball and a ball on a ", sg.crease ? "crease" : "non-crease", " segment ",
+                          (sg.a == vi || sg.b == vi) ? "ending there" : "not through it");
+    }
+    return absl::StrCat("features of dims ", std::min(features_.Dim(fa), features_.Dim(fb)), "/",
+                        std::max(features_.Dim(fa), features_.Dim(fb)));
+  };
+  for (const Bad& x : bad) ++kinds[kind_of(x)];
+  std::fprintf(stderr, "collar system: %zu ball pairs meet below pi/2\n", bad.size());
+  int shown = 0;
+  for (const CreaseBallPair& pr : CreaseBallPairs()) {
+    const CollarBall& a = collars_.ball(pr.ball_u);
+    const CollarBall& b = collars_.ball(pr.ball_w);
+    const double d = geom::Dist(a.center, b.center);
+    if (!(d < a.radius + b.radius && d * d > a.radius * a.radius + b.radius * b.radius)) continue;
+    if (++shown > 8) break;
+    const SegmentMesh& m = segs_[pr.seg];
+    const double x = (d * d + a.radius * a.radius - b.radius * b.radius) / (2 * d);
+    const double t = m.T(pr.u) + (m.T(pr.w) - m.T(pr.u)) * (x / d);
+    std::fprintf(stderr, "  consecutive seg %u balls %u %u: T %.9g .. %.9g neck t %.9g; between:", pr.seg, pr.ball_u,
+                 pr.ball_w, m.T(pr.u), m.T(pr.w), t);
+    for (uint32_t v = m.Next(pr.u); v != pr.w && v != SegmentMesh::kNil; v = m.Next(v)) {
+      const PointId q = m.PointOf(v);
+      std::fprintf(stderr, " [T %.9g neck %d omega %d inside %d]", m.T(v),
+                   q.value() < neck_point_.size() ? int(neck_point_[q.value()]) : 0, int(points_.InMesh(q, kOmegaMesh)),
+                   int(collars_.StrictlyInside(points_.Xyz(q))));
+    }
+    std::fprintf(stderr, "\n");
+  }
+  for (const auto& [k, c] : kinds) std::fprintf(stderr, "  %6d %s\n", c, k.c_str());
+  std::sort(bad.begin(), bad.end(), [](const Bad& x, const Bad& y) { return x.ratio > y.ratio; });
+  for (size_t k = 0; k < bad.size() && k < 12; ++k) {
+    const Bad& x = bad[k];
+    const CollarBall& a = collars_.ball(x.a);
+    const CollarBall& b = collars_.ball(x.b);
+    const FeatureId fa = points_.Parent(collar_centre_[x.a]), fb = points_.Parent(collar_centre_[x.b]);
+    std::fprintf(stderr,
+                 "  ratio %.4f balls %u (dim %d feature %u, r %.3g at %.6g %.6g %.6g) %u (dim %d feature %u, r %.3g): %s\n",
+                 x.ratio, x.a, features_.Dim(fa), features_.Index(fa), a.radius, a.center.x, a.center.y, a.center.z,
+                 x.b, features_.Dim(fb), features_.Index(fb), b.radius, kind_of(x).c_str());
+  }
+}
+
 absl::StatusOr<uint32_t> Refiner::RepairStitchFailures() {
   // A T′ face whose star over its ball's centre is inverted lies nearly
   // edge-on to the centre; its Voronoi edge's root x on S is the centre of
@@ -2800,6 +2881,7 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
         // The collar system's smoothness (Lemma 14) in the message: every
         // input that stopped here so far had balls meeting below π/2.
         const CollarIndex::Smoothness sm = refiner.collars().MeasureSmoothness();
+        if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) refiner.DebugNonSmoothPairs();
         if (sm.not_smooth == 0) return more.status();
         return absl::Status(more.status().code(),
                             absl::StrCat(more.status().message(), "; the collar system is not smooth: ", sm.not_smooth,
