@@ -37,7 +37,7 @@ uint32_t CollarIndex::Add(const CollarBall& ball) {
   return id;
 }
 
-CollarIndex::Smoothness CollarIndex::MeasureSmoothness() const {
+void CollarIndex::ForEachIntersectingPair(const std::function<void(uint32_t, uint32_t, double)>& fn) const {
   // Sweep in x: ball j can meet ball i only if their x-extents overlap.
   std::vector<uint32_t> order(balls_.size());
   for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -45,7 +45,6 @@ CollarIndex::Smoothness CollarIndex::MeasureSmoothness() const {
     const double la = balls_[a].center.x - balls_[a].radius, lb = balls_[b].center.x - balls_[b].radius;
     return la < lb || (la == lb && a < b);
   });
-  Smoothness s;
   for (size_t k = 0; k < order.size(); ++k) {
     const CollarBall& a = balls_[order[k]];
     for (size_t l = k + 1; l < order.size(); ++l) {
@@ -53,14 +52,20 @@ CollarIndex::Smoothness CollarIndex::MeasureSmoothness() const {
       if (b.center.x - b.radius > a.center.x + a.radius) break;
       const double d = geom::Dist(a.center, b.center);
       if (d >= a.radius + b.radius || d <= std::fabs(a.radius - b.radius)) continue;  // spheres apart or nested
-      ++s.intersecting;
-      const double ratio = d * d / (a.radius * a.radius + b.radius * b.radius);
-      if (ratio > 1) {
-        ++s.not_smooth;
-        s.worst = std::max(s.worst, ratio);
-      }
+      fn(order[k], order[l], d * d / (a.radius * a.radius + b.radius * b.radius));
     }
   }
+}
+
+CollarIndex::Smoothness CollarIndex::MeasureSmoothness() const {
+  Smoothness s;
+  ForEachIntersectingPair([&](uint32_t, uint32_t, double ratio) {
+    ++s.intersecting;
+    if (ratio > 1) {
+      ++s.not_smooth;
+      s.worst = std::max(s.worst, ratio);
+    }
+  });
   return s;
 }
 

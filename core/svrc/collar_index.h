@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "absl/container/flat_hash_map.h"
@@ -37,6 +38,9 @@ class CollarIndex {
     double worst = 0;
   };
   Smoothness MeasureSmoothness() const;
+  // fn(i, j, |c_i c_j|² / (r_i² + r_j²)) for every pair of balls whose
+  // spheres intersect (neither apart nor nested), found by a sweep in x.
+  void ForEachIntersectingPair(const std::function<void(uint32_t, uint32_t, double)>& fn) const;
 
  private:
   struct Key {

@@ -264,8 +264,7 @@ class Refiner {
   // piece by the neck circle); returns whether any was inserted.
   absl::StatusOr<bool> SplitCollarNecks();
   // SVRC_COLLAR_DEBUG, when the COLLAR rounds fail: the intersecting ball
-  // pairs meeting below π/2 (Lemma 14) by kind, the first consecutive ones
-  // with the segment vertices between them, and the worst 12, to stderr
+  // pairs meeting below π/2 (Lemma 14) by kind and the worst 12, to stderr
   // (docs/svrc-collars.md "Session 8").
   void DebugNonSmoothPairs() const;
   // RefineOptions::early_crease_vertices: every crease input vertex (not a
@@ -1678,6 +1677,21 @@ bool CrossesPlane(const plc::FacetFrame& fr, const Vec3& pa, const Vec3& pb, dou
   return true;
 }
 
+// The point of the circle where `ball`'s sphere meets the plane of frame fr
+// (S ∩ F for a facet through the centre) radially nearest to uv, in fr's
+// coordinates; false when the plane misses the ball or uv is the circle's
+// centre.
+bool NearestArcPoint(const plc::FacetFrame& fr, const CollarBall& ball, const Vec2& uv, Vec2* q) {
+  const Vec2 cuv = fr.ToPlane(ball.center);
+  const double hc = geom::Dot(ball.center - fr.origin, fr.normal);
+  const double rp2 = ball.radius * ball.radius - hc * hc;
+  if (!(rp2 > 0)) return false;
+  const double dx = uv.x - cuv.x, dy = uv.y - cuv.y, d = std::hypot(dx, dy);
+  if (!(d > 0)) return false;
+  *q = Vec2{cuv.x + std::sqrt(rp2) * dx / d, cuv.y + std::sqrt(rp2) * dy / d};
+  return true;
+}
+
 // CollarRepair::Reason in error messages.
 constexpr const char* kCollarRepairName[] = {"topology", "angle", "circle", "size"};
 
@@ -1742,19 +1756,11 @@ void Refiner::DebugNonSmoothPairs() const {
     uint32_t a, b;
   };
   std::vector<Bad> bad;
-  const uint32_t n = collars_.size();
-  for (uint32_t i = 0; i < n; ++i) {
-    const CollarBall& a = collars_.ball(i);
-    for (uint32_t j = i + 1; j < n; ++j) {
-      const CollarBall& b = collars_.ball(j);
-      const double d = geom::Dist(a.center, b.center);
-      if (d >= a.radius + b.radius || d <= std::fabs(a.radius - b.radius)) continue;
-      const double ratio = d * d / (a.radius * a.radius + b.radius * b.radius);
-      if (ratio > 1) bad.push_back({ratio, i, j});
-    }
-  }
+  collars_.ForEachIntersectingPair([&](uint32_t i, uint32_t j, double ratio) {
+    if (ratio > 1) bad.push_back({ratio, std::min(i, j), std::max(i, j)});
+  });
   // Kinds: "consecutive" = neighbours on a crease segment's chain (a neck
-  // split should have separated them); otherwise by the centres' features.
+  // split is pending); otherwise by the centres' features.
   std::map<std::string, int> kinds;
   auto kind_of = [&](const Bad& x) {
     if (consecutive.count({x.a, x.b})) return std::string("consecutive on a crease segment");
@@ -1772,26 +1778,6 @@ void Refiner::DebugNonSmoothPairs() const {
   };
   for (const Bad& x : bad) ++kinds[kind_of(x)];
   std::fprintf(stderr, "collar system: %zu ball pairs meet below pi/2\n", bad.size());
-  int shown = 0;
-  for (const CreaseBallPair& pr : CreaseBallPairs()) {
-    const CollarBall& a = collars_.ball(pr.ball_u);
-    const CollarBall& b = collars_.ball(pr.ball_w);
-    const double d = geom::Dist(a.center, b.center);
-    if (!(d < a.radius + b.radius && d * d > a.radius * a.radius + b.radius * b.radius)) continue;
-    if (++shown > 8) break;
-    const SegmentMesh& m = segs_[pr.seg];
-    const double x = (d * d + a.radius * a.radius - b.radius * b.radius) / (2 * d);
-    const double t = m.T(pr.u) + (m.T(pr.w) - m.T(pr.u)) * (x / d);
-    std::fprintf(stderr, "  consecutive seg %u balls %u %u: T %.9g .. %.9g neck t %.9g; between:", pr.seg, pr.ball_u,
-                 pr.ball_w, m.T(pr.u), m.T(pr.w), t);
-    for (uint32_t v = m.Next(pr.u); v != pr.w && v != SegmentMesh::kNil; v = m.Next(v)) {
-      const PointId q = m.PointOf(v);
-      std::fprintf(stderr, " [T %.9g neck %d omega %d inside %d]", m.T(v),
-                   q.value() < neck_point_.size() ? int(neck_point_[q.value()]) : 0, int(points_.InMesh(q, kOmegaMesh)),
-                   int(collars_.StrictlyInside(points_.Xyz(q))));
-    }
-    std::fprintf(stderr, "\n");
-  }
   for (const auto& [k, c] : kinds) std::fprintf(stderr, "  %6d %s\n", c, k.c_str());
   std::sort(bad.begin(), bad.end(), [](const Bad& x, const Bad& y) { return x.ratio > y.ratio; });
   for (size_t k = 0; k < bad.size() && k < 12; ++k) {
@@ -1899,13 +1885,8 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
           const Vec3& pb = dt.Point(t.v[(k + 1) % 3]);
           Vec3 x;
           if (!CrossesPlane(fr, pa, pb, 1e-12 * ball.radius, &x)) continue;
-          const Vec2 uv = fr.ToPlane(x), cuv = fr.ToPlane(ball.center);
-          const double hc = geom::Dot(ball.center - fr.origin, fr.normal);
-          const double rp2 = ball.radius * ball.radius - hc * hc;
-          if (!(rp2 > 0)) continue;
-          const double dx = uv.x - cuv.x, dy = uv.y - cuv.y, d = std::hypot(dx, dy);
-          if (!(d > 0)) continue;
-          const Vec2 q{cuv.x + std::sqrt(rp2) * dx / d, cuv.y + std::sqrt(rp2) * dy / d};
+          Vec2 q;
+          if (!NearestArcPoint(fr, ball, fr.ToPlane(x), &q)) continue;
           if (facets_[f].region().Locate(q) == FacetRegion::Where::kOutside) continue;
           crossings.push_back({f, q});
         }
@@ -2071,13 +2052,7 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
             // halves the chord, as the COLLAR rounds do for T′ edges.
             const std::span<const uint32_t> through = FacetsThrough(collar_centre_[in]);
             if (!std::binary_search(through.begin(), through.end(), f)) continue;
-            const CollarBall& ball = collars_.ball(in);
-            const Vec2 cuv = fr.ToPlane(ball.center);
-            const double hc = geom::Dot(ball.center - fr.origin, fr.normal);
-            const double rp2 = ball.radius * ball.radius - hc * hc;
-            const double dx = uv.x - cuv.x, dy = uv.y - cuv.y, d = std::hypot(dx, dy);
-            if (!(rp2 > 0) || !(d > 0)) continue;
-            uv = Vec2{cuv.x + std::sqrt(rp2) * dx / d, cuv.y + std::sqrt(rp2) * dy / d};
+            if (!NearestArcPoint(fr, collars_.ball(in), uv, &uv)) continue;
             // Not on S when another ball swallows it.
             const uint32_t other = collars_.FindContaining(fr.ToSpace(uv));
             if (other != CollarIndex::kNone && other != in) continue;

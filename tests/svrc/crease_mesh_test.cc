@@ -87,6 +87,16 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what) {
   return out;
 }
 
+// MeshAndCheck on a corpus file (path relative to the corpus).
+CreaseMeshed MeshCorpusFileAndCheck(const std::string& path) {
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(path));
+  if (!plc.ok()) {
+    ADD_FAILURE() << path << ": " << plc.status();
+    return {};
+  }
+  return MeshAndCheck(*plc, path);
+}
+
 // Two facets meeting at 30° inside a box (families.h CreaseFacetPair): the
 // input whose open facets inside the collars made the labelling flood until
 // the final faces on each facet were taken from the stitched mesh instead of
@@ -204,9 +214,7 @@ TEST(CreaseMesh, CorpusInputsThatMesh) {
   // RepBall floor before).
   for (const char* f : {"c_creases/knife_edge.poly", "c_creases/knife_edge.obj", "b_internal/example.poly",
                         "d_small_angles/segment_fan.poly", "c_creases/schonhardt.off"}) {
-    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(f));
-    ASSERT_TRUE(plc.ok()) << f << ": " << plc.status();
-    MeshAndCheck(*plc, f);
+    MeshCorpusFileAndCheck(f);
   }
 }
 
@@ -221,9 +229,7 @@ TEST(CreaseMesh, Wedge1) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
 #endif
-  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/wedge-1.smesh"));
-  ASSERT_TRUE(plc.ok()) << plc.status();
-  MeshAndCheck(*plc, "wedge-1.smesh");
+  MeshCorpusFileAndCheck("c_creases/wedge-1.smesh");
 }
 
 // The other generated crease families of issue #6: a free segment leaving a
@@ -320,10 +326,7 @@ TEST(CreaseMesh, LONG_HingeMeshes) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
 #endif
-  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("f_real/hinge.stl"));
-  ASSERT_TRUE(plc.ok()) << plc.status();
-  const CreaseMeshed r = MeshAndCheck(*plc, "hinge.stl");
-  EXPECT_GT(r.tets, 100000u);
+  EXPECT_GT(MeshCorpusFileAndCheck("f_real/hinge.stl").tets, 100000u);
 }
 
 // A flat tetrahedron (base creases at 26.6°). Its (1,2) points were strictly
