@@ -190,6 +190,27 @@ void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<Loca
   cs.size = 0;
 }
 
+void LocationGraph::RemoveCellLinksWhere(MeshId mesh, uint32_t cell, const std::vector<uint8_t>& drop) {
+  if (FindCellSpan(mesh, cell) == nullptr) return;
+  Span& cs = cell_spans_[mesh.value()][cell];
+  CellEntry* e = cell_arena_.Data(cs);
+  const uint32_t n = std::min<uint32_t>(cs.size, static_cast<uint32_t>(drop.size()));
+  uint32_t kept = 0;
+  for (uint32_t i = 0; i < cs.size; ++i) {
+    if (i >= n || drop[i] == 0) {
+      e[kept++] = e[i];
+      continue;
+    }
+    const LocationObject object = e[i].object();
+    Span& os = ObjectSpan(object);
+    object_arena_.Erase(os, ObjectPos(os, mesh, cell));
+    if (e[i].unresolved) --cs.unresolved;
+  }
+  num_links_ -= cs.size - kept;
+  stats_.links_removed += cs.size - kept;
+  cs.size = kept;
+}
+
 void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::vector<uint32_t>* cells) {
   if (FindObjectSpan(object) == nullptr) return;
   Span& os = ObjectSpan(object);

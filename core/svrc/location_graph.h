@@ -71,6 +71,12 @@ class LocationGraph {
   // Removes every link of a cell, appending the objects to `removed` (in link
   // order) when non-null. Used when a cell changes (UpdateLocation).
   void RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<LocationObject>* removed);
+  // Removes the links of a cell whose entry i (in link order, as ObjectsOf
+  // lists them) has drop[i] != 0; the kept links keep their order and ids.
+  // `drop` has one entry per link of the cell. UpdateLocation for a cell that
+  // shrank: its surviving links stay in place instead of being removed and
+  // added again.
+  void RemoveCellLinksWhere(MeshId mesh, uint32_t cell, const std::vector<uint8_t>& drop);
   // Removes every link of an object in `mesh` (all meshes if mesh is kNoneMesh),
   // appending the cells to `cells` when non-null.
   void RemoveObjectLinks(LocationObject object, MeshId mesh, std::vector<uint32_t>* cells);

@@ -471,6 +471,8 @@ class Refiner {
   uint32_t ball_stamp_ = 0;
   std::vector<BallId> gathered_;
   std::vector<LocationObject> objects_;
+  std::vector<LocationObject> moves_;  // UpdateLocation: 0-balls moving to the new cell
+  std::vector<uint8_t> drop_;          // UpdateLocation: links of a shrunk cell to remove
 };
 
 absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments) {
@@ -1286,38 +1288,57 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // |xc| ≤ r + R_x (V(x) ⊂ B(x, R_x)): a conservative test over 𝒱'.
   ++ball_stamp_;
   if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
+  // The old cells only shrink (V_new(u) ⊂ V_old(u)), so their links are
+  // filtered in place: a 0-ball whose point is now nearer to p moves to p's
+  // cell, a lower ball that no longer passes the test goes; the others stay
+  // (before session 9 every link of every changed cell was removed and added
+  // again: ~140 link operations per insertion on cube.poly --max-volume 1e-5).
+  // V(p) ⊂ ∪ V_old(u), so every ball meeting V(p) was linked to some u: p's
+  // cell gets the lower balls of 𝒱 that pass the test.
   std::vector<BallId> moved_pieces;
+  LinkFacts unresolved_facts;
+  unresolved_facts.unresolved = true;
   for (size_t i = 0; i + 1 < changed.size(); ++i) {
     const VertexId u = changed[i];
     objects_.clear();
-    blg_.RemoveCellLinks(kOmegaMesh, u.value(), &objects_);
+    blg_.ObjectsOf(kOmegaMesh, u.value(), &objects_);
+    if (objects_.empty()) continue;
+    drop_.assign(objects_.size(), 0);
+    moves_.clear();
     const Vec3& pu = dt.Point(u);
-    for (const LocationObject& o : objects_) {
+    for (size_t k = 0; k < objects_.size(); ++k) {
+      const LocationObject& o = objects_[k];
       const BallId b(o.id);
-      if (!balls_.IsAlive(b)) continue;
+      if (!balls_.IsAlive(b)) {
+        drop_[k] = 1;
+        continue;
+      }
       if (!balls_.IsVertexBall(b)) {
         if (ball_mark_[b.value()] != ball_stamp_) {
           ball_mark_[b.value()] = ball_stamp_;
           moved_pieces.push_back(b);
         }
+        if (!(geom::Dist(pu, balls_.Center(b)) <= (balls_.Radius(b) + sizes[i].outradius) * (1 + 1e-9))) drop_[k] = 1;
         continue;
       }
-      if (points_.InMesh(balls_.VertexPoint(b), kOmegaMesh) || Suppressed(balls_.VertexPoint(b))) continue;
+      if (points_.InMesh(balls_.VertexPoint(b), kOmegaMesh) || Suppressed(balls_.VertexPoint(b))) {
+        drop_[k] = 1;
+        continue;
+      }
       const Vec3& q = balls_.Center(b);
       const int cmp = geom::CompareDistance(q, pu, pos);  // > 0: u is farther
-      const bool to_new = cmp > 0 || (cmp == 0 && p.value() < omega_.PointOf(u).value());
-      LinkFacts facts;
-      facts.unresolved = true;
-      blg_.AddLink(kOmegaMesh, to_new ? nv.value() : u.value(), o, facts, &balls_);
-    }
-  }
-  for (BallId b : moved_pieces) {
-    const Vec3& c = balls_.Center(b);
-    const double r = balls_.Radius(b);
-    for (size_t i = 0; i < changed.size(); ++i) {
-      if (geom::Dist(dt.Point(changed[i]), c) <= (r + sizes[i].outradius) * (1 + 1e-9)) {
-        AddBallLink(changed[i], b);
+      if (cmp > 0 || (cmp == 0 && p.value() < omega_.PointOf(u).value())) {
+        drop_[k] = 1;
+        moves_.push_back(o);
       }
+    }
+    blg_.RemoveCellLinksWhere(kOmegaMesh, u.value(), drop_);
+    for (const LocationObject& o : moves_) blg_.AddLink(kOmegaMesh, nv.value(), o, unresolved_facts, &balls_);
+  }
+  const size_t inew = changed.size() - 1;
+  for (BallId b : moved_pieces) {
+    if (geom::Dist(pos, balls_.Center(b)) <= (balls_.Radius(b) + sizes[inew].outradius) * (1 + 1e-9)) {
+      AddBallLink(nv, b);
     }
   }
   // Figure 3.5's loop over 𝒱': DecreaseSize / enqueue Skinny and Unresolved.
@@ -1439,42 +1460,59 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
   // (c): re-link the lower balls of the old cells to the new cells.
   ++ball_stamp_;
   if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
+  // As in ForceInsertOmega: the shrunk old cells keep their surviving links
+  // in place; the new cell gets the 0-balls now nearer to p and the pieces
+  // of 𝒱 that pass the test.
   std::vector<BallId> moved_pieces;
   const delaunay::Delaunay2& dt = m.dt();
+  auto piece_meets = [&](BallId b, const Vec2& x, double outradius) {
+    const Vec2 a = Uv(f, balls_.Vertex(b, 0)), c = Uv(f, balls_.Vertex(b, 1));
+    const Vec2 mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
+    const double rad = 0.5 * std::hypot(a.x - c.x, a.y - c.y);
+    return std::hypot(x.x - mid.x, x.y - mid.y) <= (rad + outradius) * (1 + 1e-9);
+  };
+  LinkFacts unresolved_facts;
+  unresolved_facts.unresolved = true;
   for (size_t i = 0; i + 1 < changed.size(); ++i) {
     const VertexId2 u = changed[i];
     objects_.clear();
-    blg_.RemoveCellLinks(mesh, u.value(), &objects_);
+    blg_.ObjectsOf(mesh, u.value(), &objects_);
+    if (objects_.empty()) continue;
+    drop_.assign(objects_.size(), 0);
+    moves_.clear();
     const Vec2 pu = dt.Point(u);
-    for (const LocationObject& o : objects_) {
+    for (size_t k = 0; k < objects_.size(); ++k) {
+      const LocationObject& o = objects_[k];
       const BallId b(o.id);
-      if (!balls_.IsAlive(b)) continue;
+      if (!balls_.IsAlive(b)) {
+        drop_[k] = 1;
+        continue;
+      }
       if (!balls_.IsVertexBall(b)) {
         if (ball_mark_[b.value()] != ball_stamp_) {
           ball_mark_[b.value()] = ball_stamp_;
           moved_pieces.push_back(b);
         }
+        if (!piece_meets(b, pu, sizes[i].outradius)) drop_[k] = 1;
         continue;
       }
       const PointId q = balls_.VertexPoint(b);
-      if (points_.InMesh(q, mesh) || Suppressed(q)) continue;
+      if (points_.InMesh(q, mesh) || Suppressed(q)) {
+        drop_[k] = 1;
+        continue;
+      }
       const int cmp = geom::CompareDistance(Uv(f, q), pu, uv);  // > 0: u is farther
-      const bool to_new = cmp > 0 || (cmp == 0 && p.value() < m.PointOf(u).value());
-      LinkFacts facts;
-      facts.unresolved = true;
-      blg_.AddLink(mesh, to_new ? nv.value() : u.value(), o, facts, &balls_);
-    }
-  }
-  for (BallId b : moved_pieces) {
-    const Vec2 a = Uv(f, balls_.Vertex(b, 0)), c = Uv(f, balls_.Vertex(b, 1));
-    const Vec2 mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
-    const double rad = 0.5 * std::hypot(a.x - c.x, a.y - c.y);
-    for (size_t i = 0; i < changed.size(); ++i) {
-      const Vec2 x = dt.Point(changed[i]);
-      if (std::hypot(x.x - mid.x, x.y - mid.y) <= (rad + sizes[i].outradius) * (1 + 1e-9)) {
-        AddFacetPieceLink(f, changed[i], b);
+      if (cmp > 0 || (cmp == 0 && p.value() < m.PointOf(u).value())) {
+        drop_[k] = 1;
+        moves_.push_back(o);
       }
     }
+    blg_.RemoveCellLinksWhere(mesh, u.value(), drop_);
+    for (const LocationObject& o : moves_) blg_.AddLink(mesh, nv.value(), o, unresolved_facts, &balls_);
+  }
+  const size_t inew = changed.size() - 1;
+  for (BallId b : moved_pieces) {
+    if (piece_meets(b, dt.Point(nv), sizes[inew].outradius)) AddFacetPieceLink(f, nv, b);
   }
   const VertexId start = omega_cells.empty() ? VertexId(0) : VertexId(omega_cells[0]);
   // (b): a point M_F created inside (the closure of) F gets a 0-ball, which

@@ -410,7 +410,20 @@ TEST(LocationGraphTest, MatchesReferenceModelOrder) {
           ++removed_total;
           break;
         }
-        case 2: {  // a whole cell, reported in link order
+        case 2: {  // a whole cell, reported in link order; or some of its links, by mask
+          if (rng() % 2 == 0) {
+            // RemoveCellLinksWhere: the masked links go, the rest keep their order.
+            const std::vector<LocationObject> before = model.Objects(m, c);
+            std::vector<uint8_t> drop(before.size());
+            for (uint8_t& d : drop) d = rng() % 3 == 0;
+            g.RemoveCellLinksWhere(m, c, drop);
+            size_t k = 0;
+            for (BlgModel::Link& l : model.links) {
+              if (!l.live || l.mesh != m || l.cell != c) continue;
+              if (drop[k++]) l.live = false, ++removed_total;
+            }
+            break;
+          }
           std::vector<LocationObject> got;
           g.RemoveCellLinks(m, c, &got);
           ASSERT_EQ(got, model.Objects(m, c)) << "RemoveCellLinks step " << step;
