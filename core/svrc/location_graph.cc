@@ -58,6 +58,23 @@ inline LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) 
   return spans[cell];
 }
 
+// The cell's unresolved count went 0 -> 1 / 1 -> 0: it joins / leaves its
+// mesh's list of unresolved cells (swap with the last on removal).
+void LocationGraph::EnterUnresolved(MeshId mesh, uint32_t cell, Span& cs) {
+  if (unresolved_cells_.size() <= mesh.value()) unresolved_cells_.resize(mesh.value() + 1);
+  std::vector<uint32_t>& list = unresolved_cells_[mesh.value()];
+  cs.upos = static_cast<uint32_t>(list.size());
+  list.push_back(cell);
+}
+
+void LocationGraph::LeaveUnresolved(MeshId mesh, Span& cs) {
+  std::vector<uint32_t>& list = unresolved_cells_[mesh.value()];
+  const uint32_t last = list.back();
+  list[cs.upos] = last;
+  cell_spans_[mesh.value()][last].upos = cs.upos;
+  list.pop_back();
+}
+
 inline LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
   std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
   if (spans.size() <= object.id) [[unlikely]] spans.resize(object.id + 1);
@@ -122,7 +139,7 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
 
   if (facts.unresolved) {
     result.cell_became_unresolved = (cs.unresolved == 0);
-    ++cs.unresolved;
+    if (cs.unresolved++ == 0) EnterUnresolved(mesh, cell, cs);
   }
   // Figure 3.10: a ConfBall with the cell's vertex strictly inside is
   // encroached; native vertices trigger at once, others on the second,
@@ -136,8 +153,8 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   return result;
 }
 
-void LocationGraph::RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi) {
-  if (cell_arena_.Data(cs)[ci].unresolved) --cs.unresolved;
+void LocationGraph::RemoveAt(MeshId mesh, Span& cs, uint32_t ci, Span& os, uint32_t oi) {
+  if (cell_arena_.Data(cs)[ci].unresolved && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
   cell_arena_.Erase(cs, ci);
   object_arena_.Erase(os, oi);
   --num_links_;
@@ -154,7 +171,7 @@ void LocationGraph::RemoveLink(LinkId id) {
         if (e[i].link != id.value()) continue;
         const LocationObject object = e[i].object();
         Span& os = ObjectSpan(object);
-        RemoveAt(cs, i, os, ObjectPos(os, MeshId(m), c));
+        RemoveAt(MeshId(m), cs, i, os, ObjectPos(os, MeshId(m), c));
         return;
       }
     }
@@ -168,7 +185,7 @@ bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object
   const uint32_t oi = ObjectPos(*os, mesh, cell);
   if (oi == kNil) return false;
   const uint32_t ci = CellPos(*cs, object);
-  RemoveAt(cell_spans_[mesh.value()][cell], ci, ObjectSpan(object), oi);
+  RemoveAt(mesh, cell_spans_[mesh.value()][cell], ci, ObjectSpan(object), oi);
   return true;
 }
 
@@ -184,6 +201,7 @@ void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<Loca
     Span& os = ObjectSpan(object);
     object_arena_.Erase(os, ObjectPos(os, mesh, cell));
   }
+  if (cs.unresolved != 0) LeaveUnresolved(mesh, cs);
   cs.unresolved = 0;
   num_links_ -= cs.size;
   stats_.links_removed += cs.size;
@@ -204,7 +222,7 @@ void LocationGraph::RemoveCellLinksWhere(MeshId mesh, uint32_t cell, const std::
     const LocationObject object = e[i].object();
     Span& os = ObjectSpan(object);
     object_arena_.Erase(os, ObjectPos(os, mesh, cell));
-    if (e[i].unresolved) --cs.unresolved;
+    if (e[i].unresolved && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
   }
   num_links_ -= cs.size - kept;
   stats_.links_removed += cs.size - kept;
@@ -227,7 +245,7 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
     if (cells != nullptr) cells->push_back(oe.cell);
     Span& cs = cell_spans_[oe.mesh][oe.cell];
     const uint32_t ci = CellPos(cs, object);
-    if (cell_arena_.Data(cs)[ci].unresolved) --cs.unresolved;
+    if (cell_arena_.Data(cs)[ci].unresolved && --cs.unresolved == 0) LeaveUnresolved(MeshId(oe.mesh), cs);
     cell_arena_.Erase(cs, ci);
     --num_links_;
     ++stats_.links_removed;
@@ -272,6 +290,7 @@ bool LocationGraph::Validate() const {
   uint64_t count = 0;
   std::vector<uint32_t> ids;
   for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
+    uint64_t mesh_total = 0;
     for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
       const Span& cs = cell_spans_[m][c];
       if (cs.size > cs.cap) return false;
@@ -286,7 +305,13 @@ bool LocationGraph::Validate() const {
         ++count;
       }
       if (cs.unresolved != unresolved) return false;
+      if (unresolved != 0) {
+        ++mesh_total;
+        const std::vector<uint32_t>& list = UnresolvedCells(MeshId(m));
+        if (cs.upos >= list.size() || list[cs.upos] != c) return false;
+      }
     }
+    if (mesh_total != UnresolvedCells(MeshId(m)).size()) return false;
   }
   // Object side: no (mesh, cell) twice in an object's array, the cell's
   // array holds the object exactly once; and every link id is distinct.

@@ -102,6 +102,12 @@ class LocationGraph {
   bool IsLinked(MeshId mesh, uint32_t cell, LocationObject object) const;
   // Unresolved objects linked to the cell (LinkFacts::unresolved links).
   uint32_t NumUnresolved(MeshId mesh, uint32_t cell) const;
+  // The cells of the mesh with an unresolved link, in no particular (but
+  // deterministic) order.
+  const std::vector<uint32_t>& UnresolvedCells(MeshId mesh) const {
+    static const std::vector<uint32_t> kNone;
+    return mesh.value() < unresolved_cells_.size() ? unresolved_cells_[mesh.value()] : kNone;
+  }
 
   uint32_t NumLinks() const { return num_links_; }
 
@@ -130,6 +136,7 @@ class LocationGraph {
     uint32_t size = 0;
     uint32_t cap = 0;  // 0: no block yet; otherwise a power of two
     uint32_t unresolved = 0;  // cell spans only
+    uint32_t upos = 0;        // cell spans with unresolved > 0: position in unresolved_cells_
   };
   // Blocks of small arrays in one vector. A full block moves to a block of
   // twice its capacity (taken from that size's free list, else appended); the
@@ -183,13 +190,16 @@ class LocationGraph {
   uint32_t NewLinkId();
   // Removes entry `oi` of the object's array and entry `ci` of the cell's
   // array, which must be the same link.
-  void RemoveAt(Span& cs, uint32_t ci, Span& os, uint32_t oi);
+  void RemoveAt(MeshId mesh, Span& cs, uint32_t ci, Span& os, uint32_t oi);
+  void EnterUnresolved(MeshId mesh, uint32_t cell, Span& cs);
+  void LeaveUnresolved(MeshId mesh, Span& cs);
 
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;
   uint32_t next_link_ = 0;  // the next LinkId (skips kNone)
   uint32_t num_links_ = 0;
   std::vector<std::vector<Span>> cell_spans_;      // [mesh][cell]
+  std::vector<std::vector<uint32_t>> unresolved_cells_;  // [mesh]: cells with unresolved > 0
   std::vector<Span> ball_spans_;
   std::vector<Span> collar_spans_;
   Stats stats_;

@@ -141,6 +141,7 @@ struct RefineStats {
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
   uint64_t destroy_cells_visited = 0;  // |𝒱| summed over Destroy calls
+  uint64_t destroys_local = 0;     // Destroy in M_Ω with no unresolved 0-ball: 𝒱 = {v}
   uint64_t max_destroy_cells = 0;
   uint64_t buckets_walked = 0;
   uint64_t max_bucket_walk = 0;

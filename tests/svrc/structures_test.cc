@@ -316,6 +316,17 @@ void ExpectSameAsModel(const LocationGraph& g, const BlgModel& model, int meshes
                        uint32_t balls, uint32_t collars, int step) {
   ASSERT_EQ(g.NumLinks(), model.NumLive()) << "step " << step;
   for (int m = 0; m < meshes; ++m) {
+    // UnresolvedCells: exactly the cells with an unresolved link.
+    std::vector<uint32_t> want_cells, got_cells = g.UnresolvedCells(MeshId(m));
+    for (const BlgModel::Link& l : model.links) {
+      if (l.live && l.unresolved && l.mesh == MeshId(m)) want_cells.push_back(l.cell);
+    }
+    std::sort(want_cells.begin(), want_cells.end());
+    want_cells.erase(std::unique(want_cells.begin(), want_cells.end()), want_cells.end());
+    std::sort(got_cells.begin(), got_cells.end());
+    ASSERT_EQ(got_cells, want_cells) << "UnresolvedCells mesh " << m << " step " << step;
+  }
+  for (int m = 0; m < meshes; ++m) {
     for (uint32_t c = 0; c < cells; ++c) {
       const std::vector<LocationObject> want = model.Objects(MeshId(m), c);
       std::vector<LocationObject> got;
