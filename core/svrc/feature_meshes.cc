@@ -148,7 +148,10 @@ CellSize OmegaMesh::ComputeSize(VertexId v) const {
       break;
     }
     const CcEntry& e = CachedCircumcenter(t);
-    if (e.flat) continue;
+    if (e.flat) {
+      out.saw_flat = true;
+      continue;
+    }
     if (!e.inside) {
       needs_clip = true;
       break;

@@ -28,6 +28,7 @@ struct CellSize {
   geom::Vec3 corner;      // farthest corner of V(v) ∩ Ω
   TetId hint;
   bool clipped = false;   // the cell reached ∂Ω or infinity and was clipped
+  bool saw_flat = false;  // a flat tet of the star was left out of R_v
 };
 
 class OmegaMesh {
@@ -61,6 +62,15 @@ class OmegaMesh {
   // cube (Sutherland–Hodgman). Corners created on a cube face get that face's
   // coordinate exactly, so they lie on ∂Ω.
   CellSize Size(VertexId v) const;
+  // The circumcentre of finite tet t as Size() reads it for each vertex of t
+  // (R_v is the largest |cc − v| over v's star); false when Size() would not
+  // read it plainly: t flat, or its circumcentre outside Ω (clipped cells).
+  bool PlainCorner(TetId t, geom::Vec3* cc) const {
+    const CcEntry& e = CachedCircumcenter(t);
+    if (e.flat || !e.inside) return false;
+    *cc = e.cc;
+    return true;
+  }
 
   // Per-cell handles of queued events (Figure 3.5: "if v' is the centre of
   // some work event, DecreaseSize it").

@@ -102,6 +102,11 @@ class LocationGraph {
   bool IsLinked(MeshId mesh, uint32_t cell, LocationObject object) const;
   // Unresolved objects linked to the cell (LinkFacts::unresolved links).
   uint32_t NumUnresolved(MeshId mesh, uint32_t cell) const;
+  // All links of the cell.
+  uint32_t NumCellLinks(MeshId mesh, uint32_t cell) const {
+    const Span* cs = FindCellSpan(mesh, cell);
+    return cs == nullptr ? 0 : cs->size;
+  }
   // The cells of the mesh with an unresolved link, in no particular (but
   // deterministic) order.
   const std::vector<uint32_t>& UnresolvedCells(MeshId mesh) const {

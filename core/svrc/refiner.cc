@@ -476,6 +476,19 @@ class Refiner {
   std::vector<BallId> gathered_;
   std::vector<LocationObject> objects_;
   std::vector<LocationObject> moves_;  // UpdateLocation: 0-balls moving to the new cell
+  // ForceInsertOmega's certificates of good cells (see there), per M_Ω
+  // vertex: r_v and whether every tet of the star passes IsBad's test.
+  // Cleared when the size targets change.
+  struct CellCert {
+    double inradius = 0;   // r_v now
+    double outradius = 0;  // R_v at the last Size(): ≥ R_v now
+    bool valid = false;
+  };
+  std::vector<CellCert> cell_cert_;
+  std::vector<TetId> created_;
+  std::vector<double> new_corner_;
+  std::vector<uint32_t> cert_mark_, cert_pos_;
+  uint32_t cert_stamp_ = 0;
   std::vector<uint8_t> drop_;          // UpdateLocation: links of a shrunk cell to remove
 };
 
@@ -1300,8 +1313,74 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   changed.push_back(nv);
   for (VertexId u : changed) omega_.BumpCell(u);
 
+  // R_v, r_v of 𝒱' (Figure 3.5's loop), or a certificate that V(u) is
+  // still good, without a star walk. cell_cert_[u] (set from u's last
+  // Size()) says: every tet t of u's star has |cc(t) − u| ≤ τ·r_u and ≤ u's
+  // size target (IsBad's test, which reads their maximum R_u), and R_u ≤ R.
+  // After p's insertion V(u) only shrank (R_u ≤ R still; no vertex leaves
+  // M_Ω), r_u = min(r_u, |up|/2) exactly (Lemma 3: the nearest point is a
+  // Delaunay neighbour), the tets u kept passed the test with the old r_u,
+  // and the new tets at u are p's (`created`). So V(u) is still good if
+  // every new tet at u passes with the new r_u and, when r_u shrank,
+  // R ≤ τ·r_u. The verdict is Size()'s own, bit for bit (the same doubles
+  // |cc − u| and r_u), so the output does not change. Every other cell
+  // gets Size(); a certified cell's links read R_u through bounds
+  // (largest |cc − u| of its new tets ≤ R_u ≤ R) and fall back to Size()
+  // only when the bounds do not decide a link.
+  const std::span<const TetId> created_span = result.created;
+  created_.assign(created_span.begin(), created_span.end());
+  ++cert_stamp_;
+  const size_t nvert = dt.NumVertices();
+  if (cert_mark_.size() < nvert) {
+    cert_mark_.resize(nvert + nvert / 2 + 16, 0);
+    cert_pos_.resize(cert_mark_.size(), 0);
+  }
+  if (cell_cert_.size() < nvert) cell_cert_.resize(nvert + nvert / 2 + 16);
+  for (size_t i = 0; i + 1 < changed.size(); ++i) {
+    cert_mark_[changed[i].value()] = cert_stamp_;
+    cert_pos_[changed[i].value()] = static_cast<uint32_t>(i);
+  }
+  // Largest |cc − u| over the new tets at each old cavity vertex u (+inf if
+  // one of them is a ghost, flat, or has its circumcentre outside Ω).
+  new_corner_.assign(changed.size(), 0.0);
+  for (TetId t : created_) {
+    Vec3 cc;
+    const bool plain = !dt.IsGhost(t) && omega_.PlainCorner(t, &cc);
+    for (int k = 0; k < 4; ++k) {
+      const VertexId u = dt.TetVertex(t, k);
+      if (u == nv || !u.valid() || u.value() >= nvert || cert_mark_[u.value()] != cert_stamp_) continue;
+      double& m = new_corner_[cert_pos_[u.value()]];
+      m = plain ? std::max(m, geom::Dist(cc, dt.Point(u))) : HUGE_VAL;
+    }
+  }
   std::vector<CellSize> sizes(changed.size());
-  for (size_t i = 0; i < changed.size(); ++i) sizes[i] = omega_.Size(changed[i]);
+  std::vector<uint8_t> exact(changed.size(), 1);
+  auto exact_size = [&](size_t i) {
+    const VertexId u = changed[i];
+    sizes[i] = omega_.Size(u);
+    exact[i] = 1;
+    cell_cert_[u.value()] = {sizes[i].inradius, sizes[i].outradius,
+                             !sizes[i].clipped && !sizes[i].saw_flat && !IsBad(u, sizes[i])};
+  };
+  for (size_t i = 0; i < changed.size(); ++i) {
+    const VertexId u = changed[i];
+    if (i + 1 < changed.size()) {
+      CellCert& cert = cell_cert_[u.value()];
+      if (cert.valid && options_.certify_cells) {
+        const double r = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
+        const double m = new_corner_[i];
+        const bool target = u.value() < size_target_.size();
+        if (!(m > options_.tau * r) && !(target && m > size_target_[u.value()]) &&
+            (r == cert.inradius || !(cert.outradius > options_.tau * r))) {
+          cert.inradius = r;
+          exact[i] = 0;
+          ++stats_.sizes_certified;
+          continue;
+        }
+      }
+    }
+    exact_size(i);
+  }
   // UpdateLocation (3.6) for F = Ω: no new ConfBalls; re-intersect the lower
   // ConfBalls of the old cells with the new cells. A point in V_old(u) is in
   // V_new(u) or V_new(p): one exact distance comparison (ties: the lower
@@ -1339,7 +1418,18 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
           ball_mark_[b.value()] = ball_stamp_;
           moved_pieces.push_back(b);
         }
-        if (!(geom::Dist(pu, balls_.Center(b)) <= (balls_.Radius(b) + sizes[i].outradius) * (1 + 1e-9))) drop_[k] = 1;
+        const double d = geom::Dist(pu, balls_.Center(b));
+        if (!exact[i]) {
+          // Certified cell: new_corner_[i] ≤ R_u ≤ cell_cert_[u].outradius.
+          if (d <= (balls_.Radius(b) + new_corner_[i]) * (1 + 1e-9)) continue;
+          if (!(d <= (balls_.Radius(b) + cell_cert_[u.value()].outradius) * (1 + 1e-9))) {
+            drop_[k] = 1;
+            continue;
+          }
+          exact_size(i);
+          ++stats_.sizes_uncertified;
+        }
+        if (!(d <= (balls_.Radius(b) + sizes[i].outradius) * (1 + 1e-9))) drop_[k] = 1;
         continue;
       }
       if (points_.InMesh(balls_.VertexPoint(b), kOmegaMesh) || Suppressed(balls_.VertexPoint(b))) {
@@ -1363,7 +1453,27 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     }
   }
   // Figure 3.5's loop over 𝒱': DecreaseSize / enqueue Skinny and Unresolved.
-  for (size_t i = 0; i < changed.size(); ++i) RefreshEvents(changed[i], &sizes[i]);
+  // A certified cell gets no event (any queued one is stale: BumpCell above).
+  // A certified cell still holding an unresolved 0-ball needs its exact
+  // farthest corner and R_v for the Unresolved event.
+  for (size_t i = 0; i < changed.size(); ++i) {
+    if (!exact[i] && blg_.NumUnresolved(kOmegaMesh, changed[i].value()) > 0) {
+      exact_size(i);
+      ++stats_.sizes_uncertified;
+    }
+    if (exact[i]) {
+      RefreshEvents(changed[i], &sizes[i]);
+    } else {
+      // RefreshEvents of a good cell without unresolved 0-balls: its queued
+      // events go (a stale handle left queued would be refreshed in place
+      // later and keep its old place in its bucket; measured with the
+      // Unresolved event on segment_fan.poly, CollarRefine test).
+      EventHandle& ue = omega_.UnresolvedEvent(changed[i]);
+      if (queues_.IsQueued(ue)) queues_.Remove(ue);
+      EventHandle& ke = omega_.SkinnyEvent(changed[i]);
+      if (queues_.IsQueued(ke)) queues_.Remove(ke);
+    }
+  }
   // Figure 3.5 lines 5–7: a crease point from a lower feature gets its collar.
   if (options_.collars && points_.IsCrease(p) && points_.CdOf(p).dim < 3) return CreateCollar(p, nv);
   return absl::OkStatus();
@@ -2346,6 +2456,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // Volumes scale by 2^−3e into normalised coordinates (exact).
   const double scale3 = std::ldexp(1.0, -3 * norm_.exponent);
   if (size_target_.size() < nv) size_target_.resize(nv, HUGE_VAL);
+  cell_cert_.clear();  // certificates read the size targets
   std::vector<uint8_t> touched(nv, 0);
   for (size_t t = 0; t < tets.size(); ++t) {
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
@@ -2724,6 +2835,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   }
   out->Set("svrc.vertices_dim3", static_cast<double>(steiner_vertices));
   out->Set("svrc.insertions", static_cast<double>(insertions));
+  out->Set("svrc.sizes_certified", static_cast<double>(sizes_certified));
+  out->Set("svrc.sizes_uncertified", static_cast<double>(sizes_uncertified));
   out->Set("svrc.destroys_local", static_cast<double>(destroys_local));
   out->Set("svrc.warps", static_cast<double>(warps));
   out->Set("svrc.yields", static_cast<double>(yields));

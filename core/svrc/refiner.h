@@ -27,6 +27,11 @@ struct RefineOptions {
   // Voronoi aspect-ratio bound τ (R_v/r_v ≤ τ at the end); the API's
   // radius_edge is τ/2 (docs/svrc-design.md §4).
   double tau = 4.0;
+  // ForceInsertOmega proves most cavity cells still good from their last
+  // Size() and the new tets (refiner.cc, cell_cert_) instead of walking their
+  // stars. false: Size() for every cavity cell, the reference the
+  // certificates must reproduce bit for bit (tests).
+  bool certify_cells = true;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
   // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
@@ -148,6 +153,8 @@ struct RefineStats {
   uint64_t links_added = 0;        // LW-events (Lemma 36)
   uint64_t links_removed = 0;
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
+  uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
+  uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)
   uint64_t predicate_calls = 0;
   uint64_t predicate_exact = 0;    // filter failures → exact arithmetic
