@@ -476,6 +476,46 @@ class Refiner {
   std::vector<BallId> gathered_;
   std::vector<LocationObject> objects_;
   std::vector<LocationObject> moves_;  // UpdateLocation: 0-balls moving to the new cell
+  // UpdateLocation (Figure 3.6) for one old cell u of `mesh` that shrank when
+  // the point of new cell `nv` was inserted: its links stay in place except
+  // dead balls, 0-balls whose point is now in the mesh or suppressed, 0-balls
+  // now nearer to the new point (nearer_to_new(b): they move to nv), and
+  // lower balls for which piece_meets(b) says no. Lower balls are recorded
+  // once per insertion in `moved` (ball_mark_/ball_stamp_) for the new cell.
+  template <typename PieceMeets, typename NearerToNew>
+  void FilterShrunkCell(MeshId mesh, uint32_t u, uint32_t nv, std::vector<BallId>* moved, PieceMeets&& piece_meets,
+                        NearerToNew&& nearer_to_new) {
+    objects_.clear();
+    blg_.ObjectsOf(mesh, u, &objects_);
+    if (objects_.empty()) return;
+    drop_.assign(objects_.size(), 0);
+    moves_.clear();
+    for (size_t k = 0; k < objects_.size(); ++k) {
+      const LocationObject& o = objects_[k];
+      const BallId b(o.id);
+      if (!balls_.IsAlive(b)) {
+        drop_[k] = 1;
+      } else if (!balls_.IsVertexBall(b)) {
+        if (ball_mark_[b.value()] != ball_stamp_) {
+          ball_mark_[b.value()] = ball_stamp_;
+          moved->push_back(b);
+        }
+        if (!piece_meets(b)) drop_[k] = 1;
+      } else {
+        const PointId q = balls_.VertexPoint(b);
+        if (points_.InMesh(q, mesh) || Suppressed(q)) {
+          drop_[k] = 1;
+        } else if (nearer_to_new(b)) {
+          drop_[k] = 1;
+          moves_.push_back(o);
+        }
+      }
+    }
+    blg_.RemoveCellLinksWhere(mesh, u, drop_);
+    LinkFacts unresolved;
+    unresolved.unresolved = true;
+    for (const LocationObject& o : moves_) blg_.AddLink(mesh, nv, o, unresolved, &balls_);
+  }
   // ForceInsertOmega's certificates of good cells (see there), per M_Ω
   // vertex: r_v and whether every tet of the star passes IsBad's test.
   // Cleared when the size targets change.
@@ -1396,55 +1436,25 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // V(p) ⊂ ∪ V_old(u), so every ball meeting V(p) was linked to some u: p's
   // cell gets the lower balls of 𝒱 that pass the test.
   std::vector<BallId> moved_pieces;
-  LinkFacts unresolved_facts;
-  unresolved_facts.unresolved = true;
   for (size_t i = 0; i + 1 < changed.size(); ++i) {
     const VertexId u = changed[i];
-    objects_.clear();
-    blg_.ObjectsOf(kOmegaMesh, u.value(), &objects_);
-    if (objects_.empty()) continue;
-    drop_.assign(objects_.size(), 0);
-    moves_.clear();
     const Vec3& pu = dt.Point(u);
-    for (size_t k = 0; k < objects_.size(); ++k) {
-      const LocationObject& o = objects_[k];
-      const BallId b(o.id);
-      if (!balls_.IsAlive(b)) {
-        drop_[k] = 1;
-        continue;
+    auto piece_meets = [&](BallId b) {
+      const double d = geom::Dist(pu, balls_.Center(b));
+      if (!exact[i]) {
+        // Certified cell: new_corner_[i] ≤ R_u ≤ cell_cert_[u].outradius.
+        if (d <= (balls_.Radius(b) + new_corner_[i]) * (1 + 1e-9)) return true;
+        if (!(d <= (balls_.Radius(b) + cell_cert_[u.value()].outradius) * (1 + 1e-9))) return false;
+        exact_size(i);
+        ++stats_.sizes_uncertified;
       }
-      if (!balls_.IsVertexBall(b)) {
-        if (ball_mark_[b.value()] != ball_stamp_) {
-          ball_mark_[b.value()] = ball_stamp_;
-          moved_pieces.push_back(b);
-        }
-        const double d = geom::Dist(pu, balls_.Center(b));
-        if (!exact[i]) {
-          // Certified cell: new_corner_[i] ≤ R_u ≤ cell_cert_[u].outradius.
-          if (d <= (balls_.Radius(b) + new_corner_[i]) * (1 + 1e-9)) continue;
-          if (!(d <= (balls_.Radius(b) + cell_cert_[u.value()].outradius) * (1 + 1e-9))) {
-            drop_[k] = 1;
-            continue;
-          }
-          exact_size(i);
-          ++stats_.sizes_uncertified;
-        }
-        if (!(d <= (balls_.Radius(b) + sizes[i].outradius) * (1 + 1e-9))) drop_[k] = 1;
-        continue;
-      }
-      if (points_.InMesh(balls_.VertexPoint(b), kOmegaMesh) || Suppressed(balls_.VertexPoint(b))) {
-        drop_[k] = 1;
-        continue;
-      }
-      const Vec3& q = balls_.Center(b);
-      const int cmp = geom::CompareDistance(q, pu, pos);  // > 0: u is farther
-      if (cmp > 0 || (cmp == 0 && p.value() < omega_.PointOf(u).value())) {
-        drop_[k] = 1;
-        moves_.push_back(o);
-      }
-    }
-    blg_.RemoveCellLinksWhere(kOmegaMesh, u.value(), drop_);
-    for (const LocationObject& o : moves_) blg_.AddLink(kOmegaMesh, nv.value(), o, unresolved_facts, &balls_);
+      return d <= (balls_.Radius(b) + sizes[i].outradius) * (1 + 1e-9);
+    };
+    auto nearer_to_new = [&](BallId b) {
+      const int cmp = geom::CompareDistance(balls_.Center(b), pu, pos);  // > 0: u is farther
+      return cmp > 0 || (cmp == 0 && p.value() < omega_.PointOf(u).value());
+    };
+    FilterShrunkCell(kOmegaMesh, u.value(), nv.value(), &moved_pieces, piece_meets, nearer_to_new);
   }
   const size_t inew = changed.size() - 1;
   for (BallId b : moved_pieces) {
@@ -1602,44 +1612,15 @@ absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hi
     const double rad = 0.5 * std::hypot(a.x - c.x, a.y - c.y);
     return std::hypot(x.x - mid.x, x.y - mid.y) <= (rad + outradius) * (1 + 1e-9);
   };
-  LinkFacts unresolved_facts;
-  unresolved_facts.unresolved = true;
   for (size_t i = 0; i + 1 < changed.size(); ++i) {
     const VertexId2 u = changed[i];
-    objects_.clear();
-    blg_.ObjectsOf(mesh, u.value(), &objects_);
-    if (objects_.empty()) continue;
-    drop_.assign(objects_.size(), 0);
-    moves_.clear();
     const Vec2 pu = dt.Point(u);
-    for (size_t k = 0; k < objects_.size(); ++k) {
-      const LocationObject& o = objects_[k];
-      const BallId b(o.id);
-      if (!balls_.IsAlive(b)) {
-        drop_[k] = 1;
-        continue;
-      }
-      if (!balls_.IsVertexBall(b)) {
-        if (ball_mark_[b.value()] != ball_stamp_) {
-          ball_mark_[b.value()] = ball_stamp_;
-          moved_pieces.push_back(b);
-        }
-        if (!piece_meets(b, pu, sizes[i].outradius)) drop_[k] = 1;
-        continue;
-      }
-      const PointId q = balls_.VertexPoint(b);
-      if (points_.InMesh(q, mesh) || Suppressed(q)) {
-        drop_[k] = 1;
-        continue;
-      }
-      const int cmp = geom::CompareDistance(Uv(f, q), pu, uv);  // > 0: u is farther
-      if (cmp > 0 || (cmp == 0 && p.value() < m.PointOf(u).value())) {
-        drop_[k] = 1;
-        moves_.push_back(o);
-      }
-    }
-    blg_.RemoveCellLinksWhere(mesh, u.value(), drop_);
-    for (const LocationObject& o : moves_) blg_.AddLink(mesh, nv.value(), o, unresolved_facts, &balls_);
+    FilterShrunkCell(
+        mesh, u.value(), nv.value(), &moved_pieces, [&](BallId b) { return piece_meets(b, pu, sizes[i].outradius); },
+        [&](BallId b) {
+          const int cmp = geom::CompareDistance(Uv(f, balls_.VertexPoint(b)), pu, uv);  // > 0: u is farther
+          return cmp > 0 || (cmp == 0 && p.value() < m.PointOf(u).value());
+        });
   }
   const size_t inew = changed.size() - 1;
   for (BallId b : moved_pieces) {
