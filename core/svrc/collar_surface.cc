@@ -44,18 +44,24 @@ bool CellMayMeetBall(const Delaunay3& dt, VertexId u, const CollarBall& b) {
 // set of Voronoi neighbours containing the cell of the centre: a walk from
 // the centre's nearest vertex through CellMayMeetBall vertices reaches them
 // all. `seen` is zero scratch of NumVertices() entries, left zero.
+// `touched` receives every vertex read (the candidates and their neighbours:
+// the cache's dependency set).
 std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b, bool local,
-                                        std::vector<uint8_t>* seen) {
+                                        TetId hint, std::vector<uint8_t>* seen, VertexId* center_vertex,
+                                        std::vector<uint32_t>* touched_out) {
   std::vector<uint32_t> out;
+  touched_out->clear();
   if (!local) {
     for (uint32_t v = 0; v < dt.NumVertices(); ++v) {
       if (dt.VertexTet(VertexId(v)).valid()) out.push_back(v);
     }
     return out;
   }
-  const VertexId s = dt.NearestVertex(b.center);
+  const VertexId s = dt.NearestVertex(b.center, hint);
+  *center_vertex = s;
   if (!s.valid()) return out;
-  std::vector<uint32_t> touched = {s.value()};
+  std::vector<uint32_t>& touched = *touched_out;
+  touched.push_back(s.value());
   std::vector<uint32_t> queue = {s.value()};
   (*seen)[s.value()] = 1;
   std::vector<VertexId> nb;
@@ -333,7 +339,7 @@ double CollarSurfaceSize(const Vec3& x, const CollarDescription& collars) {
 }
 
 CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDescription& collars,
-                                           const CollarSurfaceOptions& opt) {
+                                           const CollarSurfaceOptions& opt, CollarRestrictionCache* cache) {
   CollarRestriction r;
   const std::span<const CollarBall> balls(collars.balls);
   const size_t nb = balls.size(), nc = collars.circles.size();
@@ -343,17 +349,81 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   r.circle_state.assign(nc, 0);
   r.circle_arcs.resize(nc);
   if (!dt.Is3d()) return r;
+  // The cache serves only the same description (balls and circles) and
+  // options; otherwise it is rebuilt from this call.
+  std::vector<std::pair<uint32_t, uint32_t>> circle_balls(nc);
+  for (uint32_t k = 0; k < nc; ++k) circle_balls[k] = {collars.circles[k].a, collars.circles[k].b};
+  auto same_ball = [](const CollarBall& x, const CollarBall& y) { return x.center == y.center && x.radius == y.radius; };
+  const bool reuse = cache != nullptr && cache->valid && opt.local_search && cache->delta == opt.delta &&
+                     cache->balls.size() == nb && cache->circle_balls == circle_balls &&
+                     std::equal(balls.begin(), balls.end(), cache->balls.begin(), same_ball);
   std::vector<uint8_t> seen(dt.NumVertices(), 0), is_cand(dt.NumVertices(), 0);
   std::vector<std::vector<uint32_t>> cand(nb);
+  std::vector<uint8_t> computed(nb, 1);
+  std::vector<uint32_t> touched;
+  std::vector<RestrictedTriangle> tris;
+  std::vector<CollarRestrictionCache::PerBall> per_ball;
+  if (cache != nullptr) per_ball.resize(nb);
+  r.center_vertex.assign(nb, VertexId());
   for (uint32_t i = 0; i < nb; ++i) {
-    cand[i] = CandidateVertices(dt, balls[i], opt.local_search, &seen);
+    if (reuse) {
+      CollarRestrictionCache::PerBall& pb = cache->per_ball[i];
+      bool clean = true;
+      for (const auto& [v, g] : pb.read) {
+        if (cache->generation(v) != g) {
+          clean = false;
+          break;
+        }
+      }
+      if (clean) {
+        computed[i] = 0;
+        ++cache->balls_reused;
+        cand[i] = pb.cand;
+        r.candidates_per_ball[i] = static_cast<uint32_t>(cand[i].size());
+        r.center_vertex[i] = pb.center_vertex;
+        r.triangles.insert(r.triangles.end(), pb.triangles.begin(), pb.triangles.end());
+        per_ball[i] = std::move(pb);
+        continue;
+      }
+    }
+    // The walk to the centre starts at this ball's last centre vertex, else
+    // at the previous ball's (balls come in creation order, mostly along a
+    // crease); the default start, the last inserted tet, may be across M_Ω
+    // (measured on hinge.stl: these walks were 30% of the COLLAR rounds).
+    // NearestVertex is exact, so the hint changes no result.
+    VertexId from;
+    if (cache != nullptr && i < cache->per_ball.size()) from = cache->per_ball[i].center_vertex;
+    if (!from.valid() && i > 0) from = r.center_vertex[i - 1];
+    const TetId hint = from.valid() && from.value() < dt.NumVertices() ? dt.VertexTet(from) : TetId();
+    cand[i] = CandidateVertices(dt, balls[i], opt.local_search, hint, &seen, &r.center_vertex[i], &touched);
     r.candidates_per_ball[i] = static_cast<uint32_t>(cand[i].size());
     for (uint32_t v : cand[i]) is_cand[v] = 1;
-    SphereTriangles(dt, balls, i, cand[i], is_cand, opt.delta, &r.triangles);
+    tris.clear();
+    SphereTriangles(dt, balls, i, cand[i], is_cand, opt.delta, &tris);
     for (uint32_t v : cand[i]) is_cand[v] = 0;
+    r.triangles.insert(r.triangles.end(), tris.begin(), tris.end());
+    if (cache != nullptr) {
+      ++cache->balls_computed;
+      CollarRestrictionCache::PerBall& pb = per_ball[i];
+      pb.cand = cand[i];
+      pb.read.clear();
+      pb.read.reserve(touched.size());
+      for (uint32_t v : touched) pb.read.emplace_back(v, cache->generation(v));
+      pb.triangles = tris;
+      pb.center_vertex = r.center_vertex[i];
+    }
   }
   for (uint32_t k = 0; k < nc; ++k) {
     const CollarCircle& cc = collars.circles[k];
+    if (reuse && !computed[cc.a] && !computed[cc.b]) {
+      ++cache->circles_reused;
+      r.circle_arcs[k] = cache->last.circle_arcs[k];
+      r.circle_state[k] = cache->last.circle_state[k];
+      r.circle_edges[k] = cache->last.circle_edges[k];
+      r.circle_params[k] = cache->last.circle_params[k];
+      continue;
+    }
+    if (cache != nullptr) ++cache->circles_computed;
     const std::vector<CollarBall> others = OtherBalls(balls, cc.a, cc.b);
     r.circle_arcs[k] = ClipCircleByBalls(cc.circle, others);
     const auto& arcs = r.circle_arcs[k];
@@ -382,12 +452,23 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
     edges = std::move(se);
     r.circle_params[k] = std::move(sp);
   }
+  if (cache != nullptr) {
+    cache->valid = opt.local_search;
+    cache->delta = opt.delta;
+    cache->balls.assign(balls.begin(), balls.end());
+    cache->circle_balls = std::move(circle_balls);
+    cache->per_ball = std::move(per_ball);
+    cache->last.circle_arcs = r.circle_arcs;
+    cache->last.circle_state = r.circle_state;
+    cache->last.circle_edges = r.circle_edges;
+    cache->last.circle_params = r.circle_params;
+  }
   return r;
 }
 
 std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescription& collars,
                                         const CollarSurfaceOptions& opt,
-                                        CollarSurfaceReport* report) {
+                                        CollarSurfaceReport* report, CollarRestrictionCache* cache) {
   CollarSurfaceReport rep;
   std::vector<CollarRepair> out;
   const std::span<const CollarBall> balls(collars.balls);
@@ -399,9 +480,13 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     if (report != nullptr) *report = rep;
     return out;
   }
-  const CollarRestriction res = ComputeCollarRestriction(dt, collars, opt);
+  const CollarRestriction res = ComputeCollarRestriction(dt, collars, opt, cache);
   for (uint32_t c : res.candidates_per_ball) rep.candidates += c;
   const std::vector<RestrictedTriangle>& tris = res.triangles;
+  auto ball_hint = [&](uint32_t ball) {
+    const VertexId c = ball < res.center_vertex.size() ? res.center_vertex[ball] : VertexId();
+    return c.valid() ? dt.VertexTet(c) : TetId();
+  };
 
   // Adds a repair after checking that x is on S and not a vertex; the radius
   // is the distance to the nearest vertex (= the RepBall radius for a rep point).
@@ -419,8 +504,9 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       cr.ball = cc.a;
       if (InsideAnyBall(x, OtherBalls(balls, cc.a, cc.b))) return;
     }
-    const VertexId nv = dt.NearestVertex(x);
+    const VertexId nv = dt.NearestVertex(x, ball_hint(cr.ball));
     if (!nv.valid()) return;
+    cr.near = nv;
     cr.radius = geom::Dist(x, dt.Point(nv));
     if (!(cr.radius > 0)) return;  // x is a vertex already
     out.push_back(cr);
@@ -603,7 +689,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       for (const Vec3& d : dirs) {
         const Vec3 x = b.center + b.radius * d;
         if (!OnCollarSurface(x, bi, balls)) continue;
-        const VertexId nv = dt.NearestVertex(x);
+        const VertexId nv = dt.NearestVertex(x, ball_hint(bi));
         const double dist = geom::Dist(x, dt.Point(nv));
         if (dist > best_d) {
           best_d = dist;
@@ -759,7 +845,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     double best_d = -1;
     for (double t : probes) {
       const Vec3 x = CirclePoint(circle, std::fmod(t, kTwoPi));
-      const double d = geom::Dist(x, dt.Point(dt.NearestVertex(x)));
+      const double d = geom::Dist(x, dt.Point(dt.NearestVertex(x, ball_hint(collars.circles[k].a))));
       if (d > best_d) {
         best_d = d;
         best_x = x;

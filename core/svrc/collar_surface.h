@@ -32,7 +32,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "core/delaunay/delaunay3.h"
@@ -66,6 +68,9 @@ struct CollarRepair {
   int collar_dim = 2;           // Definition 37's d(x): 1 on a circle, 2 on a partial sphere
   double radius = 0;            // RepBall radius (distance to the nearest vertex); priority
   Reason reason = kTopology;
+  // The vertex nearest to x when the repair was computed: a walk hint for
+  // the caller's own nearest-vertex query (M_Ω only grows in a round).
+  delaunay::VertexId near;
 };
 
 // Del(M)|_S of the whole collar description (Definition 28).
@@ -83,11 +88,53 @@ struct CollarRestriction {
   std::vector<std::vector<Arc>> circle_arcs;  // ClipCircleByBalls
   // Vertices examined per ball (the local search's cost).
   std::vector<uint32_t> candidates_per_ball;
+  // Per ball: the vertex nearest to its centre (invalid without local
+  // search), whose tet starts the walks of queries on that ball's sphere.
+  std::vector<delaunay::VertexId> center_vertex;
 };
 
+// ComputeCollarRestriction's per-ball and per-circle results kept between
+// calls on one Delaunay3 that only grows (vertices are inserted, never
+// removed), as the refiner's COLLAR rounds call it. A ball's results are a
+// function of the vertices its computation read (its candidates and their
+// Delaunay neighbours: their positions, stars and Voronoi cells) and of the
+// balls; an insertion changes the star of exactly the vertices of the tets it
+// destroys (Delaunay3::InsertResult::cavity_vertices) and whose Voronoi
+// cell meets a ball must carve it from a cell already meeting it. So a ball
+// none of whose read vertices changed since its last computation, in an
+// unchanged description, has the same candidates, triangles and roots (the
+// same tets, so the same rounding), and a circle both of whose balls are
+// unchanged the same edges. With a cache the result is identical to a call
+// without one (tests/svrc/collar_surface_test.cc checks this round by round).
+struct CollarRestrictionCache {
+  // generation(v) must move on whenever v's star changes (the refiner's
+  // OmegaMesh::CellGeneration, bumped for every cavity vertex).
+  std::function<uint32_t(uint32_t)> generation;
+  // Work done by the calls so far.
+  uint64_t balls_computed = 0, balls_reused = 0;
+  uint64_t circles_computed = 0, circles_reused = 0;
+
+  // Filled by ComputeCollarRestriction.
+  struct PerBall {
+    std::vector<uint32_t> cand;                       // ascending
+    std::vector<std::pair<uint32_t, uint32_t>> read;  // (vertex, generation) read
+    std::vector<RestrictedTriangle> triangles;
+    delaunay::VertexId center_vertex;
+  };
+  bool valid = false;
+  double delta = 0;
+  std::vector<CollarBall> balls;
+  std::vector<std::pair<uint32_t, uint32_t>> circle_balls;
+  std::vector<PerBall> per_ball;
+  CollarRestriction last;  // its circle members are reused
+};
+
+// `cache` may be null (every ball computed); with a cache the result is the
+// same and only balls whose read vertices changed are computed again.
 CollarRestriction ComputeCollarRestriction(const delaunay::Delaunay3& dt,
                                            const CollarDescription& collars,
-                                           const CollarSurfaceOptions& opt);
+                                           const CollarSurfaceOptions& opt,
+                                           CollarRestrictionCache* cache = nullptr);
 
 struct CollarSurfaceReport {
   int repairs[4] = {0, 0, 0, 0};  // by CollarRepair::Reason
@@ -128,6 +175,7 @@ double CollarSurfaceSize(const Vec3& x, const CollarDescription& collars);
 std::vector<CollarRepair> CollarRepairs(const delaunay::Delaunay3& dt,
                                         const CollarDescription& collars,
                                         const CollarSurfaceOptions& opt,
-                                        CollarSurfaceReport* report);
+                                        CollarSurfaceReport* report,
+                                        CollarRestrictionCache* cache = nullptr);
 
 }  // namespace svrc::refine

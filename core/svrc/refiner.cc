@@ -456,6 +456,9 @@ class Refiner {
   StitchResult stitch_report_;
   CollarSurfaceReport surface_report_;
   uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, crossing_count_ = 0;
+  // The COLLAR rounds' restricted Delaunay of S, per ball, reused across
+  // rounds while the cells it read keep their generations.
+  CollarRestrictionCache restriction_cache_;
   uint32_t centre_repairs_ = 0;  // points on S cutting a crease vertex's cell back inside its collar
   // Arc points for stitched tets crossing a facet inside a collar, beyond the
   // chords of T′ (RepairStitchedCrossings).
@@ -1975,7 +1978,10 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   CollarSurfaceOptions copt;
   copt.sigma = options_.max_rep_angle;
   surface_report_ = CollarSurfaceReport();
-  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_);
+  if (!restriction_cache_.generation) {
+    restriction_cache_.generation = [this](uint32_t v) { return omega_.CellGeneration(VertexId(v)); };
+  }
+  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_, &restriction_cache_);
   // A crease vertex must be strictly inside the stitched hole (Figure 3.12:
   // its star replaces the inside): every tet around it needs its
   // circumcentre inside the collars. A tet whose circumcentre is outside
@@ -2019,7 +2025,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   const delaunay::Delaunay3& dt = omega_.dt();
   std::vector<std::pair<uint32_t, Vec2>> crossings;  // (facet, arc point uv) of this round
   if (reps.empty()) {
-    const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt);
+    const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt, &restriction_cache_);
     // Facet-crossing check: RipStitchCollar's fan (centre, a, b) covers a
     // facet F through a collar centre only if T′ meets F along F's own points.
     // A T′ edge of ball i's partial sphere whose ends are strictly on opposite
@@ -2055,7 +2061,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
           r.x.y, ", ", r.x.z, ") needs a point ", r.radius / ball_r, " collar radii from the nearest vertex; the ",
           "collar surface sampling does not settle (ball ", r.ball, ", radius ", ball_r, ")"));
     }
-    const VertexId v = dt.NearestVertex(r.x);
+    const VertexId v = dt.NearestVertex(r.x, r.near.valid() ? dt.VertexTet(r.near) : TetId());
     if (dt.Point(v) == r.x) continue;
     // The RepBall is empty by construction (Definition 38); an earlier repair
     // of this round may have destroyed it.
@@ -2689,6 +2695,8 @@ void Refiner::FillCounters(RefineStats* out) const {
     }
   }
   st.collar_rounds = collar_rounds_;
+  st.collar_balls_computed = restriction_cache_.balls_computed;
+  st.collar_balls_reused = restriction_cache_.balls_reused;
   st.collar_repairs = collar_repairs_;
   st.arc_repairs = arc_repairs_;
   st.stitched_arc_crossings = stitched_arc_crossings_;
@@ -2846,6 +2854,10 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.points_12", static_cast<double>(points_12));
   out->Set("svrc.neck_splits", static_cast<double>(neck_splits));
   out->Set("svrc.collar_rounds", static_cast<double>(collar_rounds));
+  if (collars > 0) {
+    out->Set("svrc.collar_balls_computed", static_cast<double>(collar_balls_computed));
+    out->Set("svrc.collar_balls_reused", static_cast<double>(collar_balls_reused));
+  }
   out->Set("svrc.collar_repairs", static_cast<double>(collar_repairs));
   out->Set("svrc.arc_repairs", static_cast<double>(arc_repairs));
   if (collars > 0) out->Set("svrc.stitched_arc_crossings", static_cast<double>(stitched_arc_crossings));

@@ -135,6 +135,8 @@ struct RefineStats {
   uint64_t points_12 = 0;          // (1,2) points: vertex-collar spheres ∩ segments
   uint64_t neck_splits = 0;        // crease points between balls meeting below π/2 (Lemma 17)
   uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)
+  uint64_t collar_balls_computed = 0;  // Del(M)|_S of one partial sphere computed in a COLLAR round
+  uint64_t collar_balls_reused = 0;    // ... taken from the last round (no cell it read changed)
   uint64_t collar_pairs = 0;       // collar balls whose spheres intersect (pairs)
   uint64_t collar_pairs_not_smooth = 0;  // of those, meeting below π/2 (Lemma 14)
   double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those

@@ -123,7 +123,7 @@ Scene VertexAndTwoChains() {
 
 // (iv) Scene plus a jittered grid of spacing h over its bounding box (+ margin):
 // well-spread points inside and outside the balls.
-Scene WithBackground(Scene s, double h, uint64_t seed) {
+Scene WithBackground(Scene s, double h, uint64_t seed, int margin = 1) {
   s.name += " + grid";
   Vec3 lo(1e9, 1e9, 1e9), hi(-1e9, -1e9, -1e9);
   for (const CollarBall& b : s.balls) {
@@ -134,9 +134,10 @@ Scene WithBackground(Scene s, double h, uint64_t seed) {
   }
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> j(-0.25 * h, 0.25 * h);
-  for (double x = lo.x - h; x <= hi.x + h; x += h) {
-    for (double y = lo.y - h; y <= hi.y + h; y += h) {
-      for (double z = lo.z - h; z <= hi.z + h; z += h) {
+  const double m = margin * h;
+  for (double x = lo.x - m; x <= hi.x + m; x += h) {
+    for (double y = lo.y - m; y <= hi.y + m; y += h) {
+      for (double z = lo.z - m; z <= hi.z + m; z += h) {
         s.points.push_back(Vec3(x + j(rng), y + j(rng), z + j(rng)));
       }
     }
@@ -367,6 +368,135 @@ TEST(CollarSurfaceTest, ReportsTheViolationAndWhere) {
   EXPECT_EQ(reps[0].reason, CollarRepair::kTopology);
   EXPECT_EQ(reps[0].collar_dim, 2);
   EXPECT_NEAR(reps[0].radius, 1.0, 1e-12);  // the centre is the nearest vertex
+}
+
+// Whether two restrictions are the same to the bit (vertices, roots, angles,
+// radii, candidates, circle edges and states).
+bool SameRestriction(const CollarRestriction& a, const CollarRestriction& b, std::string* why) {
+  auto same_vec = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
+  if (a.triangles.size() != b.triangles.size()) {
+    *why = "triangle count " + std::to_string(a.triangles.size()) + " vs " + std::to_string(b.triangles.size());
+    return false;
+  }
+  for (size_t i = 0; i < a.triangles.size(); ++i) {
+    const RestrictedTriangle& s = a.triangles[i];
+    const RestrictedTriangle& t = b.triangles[i];
+    if (s.ball != t.ball || s.v[0] != t.v[0] || s.v[1] != t.v[1] || s.v[2] != t.v[2] || !same_vec(s.x, t.x) ||
+        s.angle != t.angle || s.rep_radius != t.rep_radius || s.num_roots != t.num_roots) {
+      *why = "triangle " + std::to_string(i);
+      return false;
+    }
+  }
+  if (a.candidates_per_ball != b.candidates_per_ball) {
+    *why = "candidates";
+    return false;
+  }
+  if (a.circle_state != b.circle_state || a.circle_params != b.circle_params) {
+    *why = "circle states or params";
+    return false;
+  }
+  for (size_t k = 0; k < a.circle_edges.size(); ++k) {
+    if (a.circle_edges[k].size() != b.circle_edges[k].size()) {
+      *why = "circle " + std::to_string(k);
+      return false;
+    }
+    for (size_t e = 0; e < a.circle_edges[k].size(); ++e) {
+      const RestrictedEdge& s = a.circle_edges[k][e];
+      const RestrictedEdge& t = b.circle_edges[k][e];
+      if (s.v[0] != t.v[0] || s.v[1] != t.v[1] || !same_vec(s.x, t.x) || s.angle != t.angle) {
+        *why = "circle " + std::to_string(k) + " edge " + std::to_string(e);
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The refiner's COLLAR rounds keep a CollarRestrictionCache: a ball whose
+// read cells kept their generations reuses its last triangles. Round by round
+// of the driver, the cached restriction must equal a fresh one to the bit,
+// and most balls must be reused once the repairs become local. With a
+// generation function that never moves (a broken dependency record), the
+// cached result must go wrong: the comparison can fail.
+struct CacheRun {
+  int rounds = 0, mismatches = 0;
+  uint64_t computed = 0, reused = 0;
+  std::string first_why;
+};
+
+// Inserts at most `per_round` repairs a round (largest first), so that later
+// rounds leave most balls untouched, as the refiner's tail rounds do.
+CacheRun DriveWithCache(const Scene& s, bool track_generations, size_t per_round, int max_rounds) {
+  uint32_t id = 0;
+  Delaunay3 dt = Build(s, &id);
+  const CollarDescription cd = BuildCollarDescription(s.balls);
+  const CollarSurfaceOptions opt = Sigma(30);
+  std::vector<uint32_t> gen(dt.NumVertices(), 0);
+  CollarRestrictionCache cache;
+  cache.generation = [&](uint32_t v) { return v < gen.size() ? gen[v] : 0u; };
+  CacheRun run;
+  for (run.rounds = 0; run.rounds < max_rounds; ++run.rounds) {
+    const CollarRestriction cached = ComputeCollarRestriction(dt, cd, opt, &cache);
+    const CollarRestriction fresh = ComputeCollarRestriction(dt, cd, opt);
+    std::string why;
+    if (!SameRestriction(cached, fresh, &why)) {
+      if (run.mismatches++ == 0) run.first_why = "round " + std::to_string(run.rounds) + ": " + why;
+    }
+    // The repairs drive the mesh, as in Drive (their restriction comes from
+    // the cache, every ball reused: nothing moved since the line above).
+    const std::vector<CollarRepair> reps = CollarRepairs(dt, cd, opt, nullptr, &cache);
+    if (reps.empty()) break;
+    size_t taken = 0;
+    for (const CollarRepair& rp : reps) {
+      if (taken == per_round) break;
+      const VertexId nv = dt.NearestVertex(rp.x);
+      if (geom::Dist(rp.x, dt.Point(nv)) < rp.radius * (1 - 1e-9)) continue;
+      ++taken;
+      const auto ins = dt.Insert(rp.x, id++);
+      if (ins.outcome != Delaunay3::InsertOutcome::kInserted) continue;
+      gen.resize(dt.NumVertices(), 0);
+      if (track_generations) {
+        for (VertexId u : ins.cavity_vertices) ++gen[u.value()];
+      }
+    }
+  }
+  // Of the first call of each round (CollarRepairs' call reuses every ball).
+  run.computed = cache.balls_computed;
+  run.reused = cache.balls_reused - static_cast<uint64_t>(run.rounds) * s.balls.size();
+  return run;
+}
+
+// Ten balls along x, consecutive ones crossing (|c1c2|² = 0.25 ≤ 2·0.4²).
+Scene LongChain() {
+  Scene s{"chain of 10", {}, {}, 1};
+  std::vector<std::pair<int, int>> meeting;
+  for (int k = 0; k < 10; ++k) {
+    s.balls.push_back({Vec3(0.5 * k, 0, 0), 0.4});
+    if (k > 0) meeting.push_back({k - 1, k});
+  }
+  ExpectCollarSystem(s.balls, meeting);
+  s.points.push_back(Vec3(-1.5, 0, 0));
+  for (const CollarBall& b : s.balls) s.points.push_back(b.center);
+  s.points.push_back(Vec3(6, 0, 0));
+  AddCorners(&s.points, -4, 9);
+  return s;
+}
+
+TEST(CollarSurfaceTest, CachedRestrictionEqualsFreshRoundByRound) {
+  // Grids reaching 4 spacings past the balls: the box corners' big tets
+  // (every ball's candidates when the grid ends at the spheres) stay apart.
+  for (const Scene& s : {WithBackground(LongChain(), 0.3, 3, 4), WithBackground(VertexAndTwoChains(), 0.3, 5, 4)}) {
+    const CacheRun run = DriveWithCache(s, /*track_generations=*/true, /*per_round=*/1, /*max_rounds=*/40);
+    EXPECT_EQ(run.mismatches, 0) << s.name << ": " << run.first_why;
+    EXPECT_GT(run.rounds, 3) << s.name;
+    // One repair a round changes the cells of a few balls only: at most half
+    // of the balls are computed again (measured: 172 of 400, 150 of 360).
+    EXPECT_LE(2 * run.computed, static_cast<uint64_t>(run.rounds) * s.balls.size()) << s.name;
+    std::printf("%s: %d rounds, balls computed %llu, reused %llu\n", s.name.c_str(), run.rounds,
+                static_cast<unsigned long long>(run.computed), static_cast<unsigned long long>(run.reused));
+  }
+  const CacheRun broken = DriveWithCache(WithBackground(LongChain(), 0.3, 3, 4), /*track_generations=*/false, 1, 10);
+  EXPECT_GT(broken.mismatches, 0) << "a cache that never sees a cell change must return stale triangles";
 }
 
 // The measurement asked for by issue #6: points inserted per σ and for the
