@@ -125,8 +125,10 @@ struct ArcEdge {
 // projected radially onto the circle) is kept iff it is not strictly inside
 // another disk (exact InBall) and assigned to the arc of that circle containing
 // its angle (the nearest one at rounding-level ends).
+// `index_circles` = false tests every Voronoi edge against every circle (the
+// reference the grid of circle boxes is checked against; same output).
 std::vector<ArcEdge> RestrictedArcEdges(const delaunay::Delaunay2& dt,
-                                        const FacetCollarSystem& system);
+                                        const FacetCollarSystem& system, bool index_circles = true);
 
 // Why a repair point is wanted (guide (a)–(e) in 2D, plus the facet's need of
 // vertices on the arc and the angle bound σ of §3.1.2).

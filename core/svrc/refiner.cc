@@ -459,6 +459,9 @@ class Refiner {
   // The COLLAR rounds' restricted Delaunay of S, per ball, reused across
   // rounds while the cells it read keep their generations.
   CollarRestrictionCache restriction_cache_;
+  // EnqueueMissing's memory per ball: ~0 inside the collars, else 1 + the
+  // sum of its M_Ω vertices' cell generations when it was last found in M_Ω.
+  std::vector<uint64_t> known_present_;
   uint32_t centre_repairs_ = 0;  // points on S cutting a crease vertex's cell back inside its collar
   // Arc points for stitched tets crossing a facet inside a collar, beyond the
   // chords of T′ (RepairStitchedCrossings).
@@ -2610,19 +2613,55 @@ bool Refiner::FacetHasEdge(uint32_t f, PointId a, PointId b) {
 
 bool Refiner::EnqueueMissing() {
   // Local tests (O(degree) each) instead of sorting every simplex of M_Ω:
-  // this runs whenever the queues run dry (once per size round too).
+  // this runs whenever the queues run dry (once per size round and once per
+  // COLLAR round too). A simplex found in M_Ω (and in its facets' meshes)
+  // stays there until an insertion destroys a tet holding it, which bumps
+  // the cell generation of each of its vertices; one found inside the
+  // collars stays inside (balls are only added). Both are remembered per
+  // ball (ids are never reused), so only simplices whose vertices changed
+  // are tested again. The enqueue order is that of the full scan.
+  constexpr uint64_t kInside = ~uint64_t{0};
+  if (known_present_.size() < balls_.size()) known_present_.resize(balls_.size() + balls_.size() / 2, 0);
+  // 1 + Σ generations of the vertices in M_Ω (generations only grow, so an
+  // equal sum means none moved), or 0 if one is not in M_Ω.
+  auto key_of = [&](std::span<const PointId> verts) -> uint64_t {
+    uint64_t key = 1;
+    for (PointId p : verts) {
+      const uint32_t v = points_.VertexIn(p, kOmegaMesh);
+      if (v == PointStore::kNoVertex) return 0;
+      key += omega_.CellGeneration(VertexId(v));
+    }
+    return key;
+  };
   bool more = false;
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
     SegmentMesh& m = segs_[sg];
     for (uint32_t v = 0; m.Next(v) != SegmentMesh::kNil; v = m.Next(v)) {
       const PointId a = m.PointOf(v), b = m.PointOf(m.Next(v));
-      if (options_.collars && InsideCollars(std::array<PointId, 2>{a, b})) continue;
+      const BallId piece = m.PieceBall(v);
+      const std::array<PointId, 2> ends{a, b};
+      // Facet meshes change without M_Ω: the key covers M_Ω only, so a
+      // segment of facets is always tested.
+      const bool cacheable = piece.valid() && seg_facets_[sg].empty();
+      uint64_t key = 0;
+      if (cacheable) {
+        uint64_t& known = known_present_[piece.value()];
+        if (known == kInside) continue;
+        key = key_of(ends);
+        if (key != 0 && known == key) continue;
+      }
+      if (options_.collars && InsideCollars(ends)) {
+        if (cacheable) known_present_[piece.value()] = kInside;
+        continue;
+      }
       bool missing = !OmegaHasEdge(a, b);
       for (uint32_t fc : seg_facets_[sg]) missing = missing || !FacetHasEdge(fc, a, b);
       if (missing) {
         ++stats_.tied_balls;
-        EnqueueEncroached(m.PieceBall(v));
+        EnqueueEncroached(piece);
         more = true;
+      } else if (cacheable) {
+        known_present_[piece.value()] = key;
       }
     }
   }
@@ -2631,14 +2670,21 @@ bool Refiner::EnqueueMissing() {
     for (TriId2 t : dt.Triangles()) {
       const BallId b = facets_[f].TriBall(t);
       if (!b.valid()) continue;
-      if (options_.collars &&
-          InsideCollars(std::array<PointId, 3>{balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2)})) {
+      uint64_t& known = known_present_[b.value()];
+      if (known == kInside) continue;
+      const std::array<PointId, 3> verts{balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2)};
+      const uint64_t key = key_of(verts);
+      if (key != 0 && known == key) continue;
+      if (options_.collars && InsideCollars(verts)) {
+        known = kInside;
         continue;
       }
-      if (!OmegaHasFace(balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2))) {
+      if (!OmegaHasFace(verts[0], verts[1], verts[2])) {
         ++stats_.tied_balls;
         EnqueueEncroached(b);
         more = true;
+      } else {
+        known = key;
       }
     }
   }

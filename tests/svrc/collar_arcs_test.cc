@@ -495,6 +495,38 @@ TEST_P(CollarArcsDrive, ConvergesToAConsistentSampleWithChords) {
   }
 }
 
+// RestrictedArcEdges tests each Voronoi edge against the circles whose
+// boxes meet its box, found in a grid; the output must be the all-circles
+// output to the bit. An 8 x 8 lattice of disjoint balls with radii spread
+// 0.04–0.3 (full circles), and one ball 5–40x the median (grid cells or the
+// all-circles fallback), over a plane with 3000 background points.
+TEST(CollarArcs, CircleGridGivesTheAllCirclesEdges) {
+  const plc::FacetFrame f = TiltedFrame();
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> h(-0.03, 0.03), rad(0.04, 0.3);
+  for (double big : {1.5, 12.0}) {
+    std::vector<CollarBall> balls;
+    for (int i = 0; i < 8; ++i) {
+      for (int j = 0; j < 8; ++j) balls.push_back(CollarBall{At(f, -2.8 + 0.8 * i, -2.8 + 0.8 * j, h(rng)), rad(rng)});
+    }
+    balls.push_back(CollarBall{At(f, 5 + big, 0, 0), big});
+    const FacetCollarSystem sys = FacetCollars(f, balls);
+    ASSERT_EQ(sys.arcs.size(), 65u);
+    Mesh m;
+    AddBackground(&m, 21, 3000);
+    const std::vector<ArcEdge> grid = RestrictedArcEdges(m.dt, sys);
+    const std::vector<ArcEdge> all = RestrictedArcEdges(m.dt, sys, /*index_circles=*/false);
+    ASSERT_EQ(grid.size(), all.size()) << "big=" << big;
+    ASSERT_GT(all.size(), 500u);
+    for (size_t i = 0; i < all.size(); ++i) {
+      EXPECT_TRUE(grid[i].a == all[i].a && grid[i].b == all[i].b && grid[i].arc == all[i].arc &&
+                  grid[i].x.x == all[i].x.x && grid[i].x.y == all[i].x.y && grid[i].s == all[i].s &&
+                  grid[i].crossings == all[i].crossings && grid[i].angle == all[i].angle)
+          << "edge " << i << " big=" << big;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Scenarios, CollarArcsDrive,
     ::testing::Values(Scenario{"one_ball", OneBall, 0, 1},
