@@ -462,6 +462,14 @@ class Refiner {
   // EnqueueMissing's memory per ball: ~0 inside the collars, else 1 + the
   // sum of its M_Ω vertices' cell generations when it was last found in M_Ω.
   std::vector<uint64_t> known_present_;
+  // CollarRoundImpl's memory per facet: the collar balls near it and its
+  // vertex count when ArcRepairs last found nothing to repair there.
+  struct FacetArcMemo {
+    bool settled = false;
+    uint32_t vertices = 0;
+    std::vector<uint32_t> near;
+  };
+  std::vector<FacetArcMemo> arc_memo_;
   uint32_t centre_repairs_ = 0;  // points on S cutting a crease vertex's cell back inside its collar
   // Arc points for stitched tets crossing a facet inside a collar, beyond the
   // chords of T′ (RepairStitchedCrossings).
@@ -1984,7 +1992,8 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   if (!restriction_cache_.generation) {
     restriction_cache_.generation = [this](uint32_t v) { return omega_.CellGeneration(VertexId(v)); };
   }
-  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_, &restriction_cache_);
+  CollarRestrictionCache* cache = options_.reuse_round_work ? &restriction_cache_ : nullptr;
+  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_, cache);
   // A crease vertex must be strictly inside the stitched hole (Figure 3.12:
   // its star replaces the inside): every tet around it needs its
   // circumcentre inside the collars. A tet whose circumcentre is outside
@@ -2028,7 +2037,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   const delaunay::Delaunay3& dt = omega_.dt();
   std::vector<std::pair<uint32_t, Vec2>> crossings;  // (facet, arc point uv) of this round
   if (reps.empty()) {
-    const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt, &restriction_cache_);
+    const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt, cache);
     // Facet-crossing check: RipStitchCollar's fan (centre, a, b) covers a
     // facet F through a collar centre only if T′ meets F along F's own points.
     // A T′ edge of ball i's partial sphere whose ends are strictly on opposite
@@ -2076,11 +2085,14 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   }
   // The 2D collar systems of the facets a collar ball reaches.
   std::vector<CollarBall> near;
+  std::vector<uint32_t> near_ids;
   std::vector<uint32_t> cand;
+  if (arc_memo_.size() < facets_.size()) arc_memo_.resize(facets_.size());
   for (uint32_t f = 0; f < facets_.size(); ++f) {
     FacetMesh& m = facets_[f];
     const plc::FacetFrame& fr = frames_[f];
     near.clear();
+    near_ids.clear();
     for (uint32_t i = 0; i < collars_.size(); ++i) {
       const CollarBall& b = collars_.ball(i);
       if (std::abs(geom::Dot(b.center - fr.origin, fr.normal)) >= b.radius) continue;
@@ -2090,21 +2102,36 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
         continue;
       }
       near.push_back(b);
+      near_ids.push_back(i);
     }
     if (near.empty()) continue;
-    const FacetCollarSystem sys = FacetCollars(fr, near);
-    ArcOptions aopt;
-    aopt.snap = options_.arc_snap;
-    if (options_.loose_arcs) {
-      aopt.require_on_arc = false;
-      aopt.eps = 0;
-    }
-    ArcReport arep;
-    std::vector<ArcRepair> ar = ArcRepairs(m.dt(), sys, options_.max_rep_angle, &arep, aopt);
-    if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr && !ar.empty()) {
-      std::fprintf(stderr, "  facet %u: %zu arc repairs: missing21 %d multi %d broken %d empty %d offarc %d angles %d size %d\n", f,
-                   ar.size(), arep.missing_points21, arep.multi_crossings, arep.broken_arcs, arep.empty_arcs,
-                   arep.off_arc_edges, arep.bad_angles, arep.too_large);
+    // ArcRepairs is a function of the facet mesh (changed only by
+    // insertions: same vertex count, same mesh) and of the balls (never
+    // changed once added): a facet that had none last round and has had no
+    // insertion since, with the same balls, has none again.
+    FacetArcMemo& memo = arc_memo_[f];
+    std::vector<ArcRepair> ar;
+    if (!(options_.reuse_round_work && memo.settled && memo.vertices == m.dt().NumVertices() && memo.near == near_ids)) {
+      const FacetCollarSystem sys = FacetCollars(fr, near);
+      ArcOptions aopt;
+      aopt.snap = options_.arc_snap;
+      if (options_.loose_arcs) {
+        aopt.require_on_arc = false;
+        aopt.eps = 0;
+      }
+      ArcReport arep;
+      ar = ArcRepairs(m.dt(), sys, options_.max_rep_angle, &arep, aopt);
+      memo.settled = ar.empty();
+      memo.vertices = m.dt().NumVertices();
+      memo.near = near_ids;
+      ++stats_.arc_facets_computed;
+      if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr && !ar.empty()) {
+        std::fprintf(stderr, "  facet %u: %zu arc repairs: missing21 %d multi %d broken %d empty %d offarc %d angles %d size %d\n", f,
+                     ar.size(), arep.missing_points21, arep.multi_crossings, arep.broken_arcs, arep.empty_arcs,
+                     arep.off_arc_edges, arep.bad_angles, arep.too_large);
+      }
+    } else {
+      ++stats_.arc_facets_settled;
     }
     std::stable_sort(ar.begin(), ar.end(), [](const ArcRepair& a, const ArcRepair& b) {
       return a.collar_dim < b.collar_dim || (a.collar_dim == b.collar_dim && a.radius > b.radius);
@@ -2621,6 +2648,7 @@ bool Refiner::EnqueueMissing() {
   // ball (ids are never reused), so only simplices whose vertices changed
   // are tested again. The enqueue order is that of the full scan.
   constexpr uint64_t kInside = ~uint64_t{0};
+  if (!options_.reuse_round_work) known_present_.clear();
   if (known_present_.size() < balls_.size()) known_present_.resize(balls_.size() + balls_.size() / 2, 0);
   // 1 + Σ generations of the vertices in M_Ω (generations only grow, so an
   // equal sum means none moved), or 0 if one is not in M_Ω.
@@ -2903,6 +2931,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   if (collars > 0) {
     out->Set("svrc.collar_balls_computed", static_cast<double>(collar_balls_computed));
     out->Set("svrc.collar_balls_reused", static_cast<double>(collar_balls_reused));
+    out->Set("svrc.arc_facets_computed", static_cast<double>(arc_facets_computed));
+    out->Set("svrc.arc_facets_settled", static_cast<double>(arc_facets_settled));
   }
   out->Set("svrc.collar_repairs", static_cast<double>(collar_repairs));
   out->Set("svrc.arc_repairs", static_cast<double>(arc_repairs));

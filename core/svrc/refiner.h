@@ -32,6 +32,12 @@ struct RefineOptions {
   // stars. false: Size() for every cavity cell, the reference the
   // certificates must reproduce bit for bit (tests).
   bool certify_cells = true;
+  // Work of the rounds run whenever the queues run dry, reused while what it
+  // read is unchanged: each collar ball's restricted Delaunay of S
+  // (CollarRestrictionCache), each facet's settled arc check, each simplex
+  // EnqueueMissing found in M_Ω. false: everything recomputed every round,
+  // the reference the reuse must reproduce bit for bit (tests).
+  bool reuse_round_work = true;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
   // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
@@ -137,6 +143,8 @@ struct RefineStats {
   uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)
   uint64_t collar_balls_computed = 0;  // Del(M)|_S of one partial sphere computed in a COLLAR round
   uint64_t collar_balls_reused = 0;    // ... taken from the last round (no cell it read changed)
+  uint64_t arc_facets_computed = 0;    // ArcRepairs of one facet in a COLLAR round
+  uint64_t arc_facets_settled = 0;     // ... skipped: nothing to repair last round, no insertion since
   uint64_t collar_pairs = 0;       // collar balls whose spheres intersect (pairs)
   uint64_t collar_pairs_not_smooth = 0;  // of those, meeting below π/2 (Lemma 14)
   double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those

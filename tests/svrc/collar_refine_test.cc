@@ -362,4 +362,48 @@ TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
     }
   }
 }
+
+// RefineOptions::reuse_round_work: the COLLAR rounds' per-ball restricted
+// Delaunay of S, the settled facets' arc checks and EnqueueMissing's memory
+// of simplices found in M_Ω must give the refinement of a run that
+// recomputes them every round, bit for bit. knife_edge.poly and
+// segment_fan.poly run many COLLAR rounds; cube.poly with max_volume runs
+// size rounds (each ends in EnqueueMissing).
+TEST(CollarRefine, ReusedRoundWorkGivesTheSameRefinement) {
+  if (kSanitized) GTEST_SKIP() << "release only";
+  struct Case {
+    const char* rel;
+    bool collars;
+    double max_volume;
+  };
+  for (const Case& c : {Case{"c_creases/knife_edge.poly", true, 0}, Case{"d_small_angles/segment_fan.poly", true, 0},
+                        Case{"a_convex/cube.poly", false, 1e-4}}) {
+    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.rel));
+    ASSERT_TRUE(plc.ok()) << c.rel << ": " << plc.status();
+    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+    ASSERT_TRUE(cx.ok()) << cx.status();
+    absl::StatusOr<PointSetRefinement> runs[2] = {absl::UnknownError("not run"), absl::UnknownError("not run")};
+    for (int reuse = 0; reuse < 2; ++reuse) {
+      RefineOptions opt;
+      opt.collars = c.collars;
+      opt.collar_surface = c.collars;
+      opt.max_volume = c.max_volume;
+      opt.max_rep_angle = 60 * M_PI / 180;
+      opt.reuse_round_work = reuse == 1;
+      runs[reuse] = RefinePlc(*cx, opt);
+      ASSERT_TRUE(runs[reuse].ok()) << c.rel << ": " << runs[reuse].status();
+    }
+    EXPECT_EQ(runs[0]->stats.collar_balls_reused, 0u) << c.rel;
+    EXPECT_EQ(runs[0]->stats.arc_facets_settled, 0u) << c.rel;
+    if (c.collars) {
+      EXPECT_GT(runs[1]->stats.collar_balls_reused, 0u) << c.rel;
+      EXPECT_GT(runs[1]->stats.collar_rounds, 3u) << c.rel;
+    }
+    EXPECT_EQ(runs[0]->tets, runs[1]->tets) << c.rel;
+    ASSERT_EQ(runs[0]->normalised_positions.size(), runs[1]->normalised_positions.size()) << c.rel;
+    for (size_t i = 0; i < runs[0]->normalised_positions.size(); ++i) {
+      ASSERT_TRUE(runs[0]->normalised_positions[i] == runs[1]->normalised_positions[i]) << c.rel << " point " << i;
+    }
+  }
+}
 }  // namespace svrc::refine
