@@ -6,6 +6,7 @@
 #include <numbers>
 #include <utility>
 
+#include "absl/container/flat_hash_map.h"
 #include "core/geometry/predicates.h"
 
 namespace svrc::refine {
@@ -305,7 +306,7 @@ std::vector<ArcEdge> RestrictedArcEdges(const Delaunay2& dt, const FacetCollarSy
     const double q = std::floor((v - lo) / cell);
     return static_cast<int64_t>(std::clamp(q, -1.0, 1e6));
   };
-  std::map<std::pair<int64_t, int64_t>, std::vector<uint32_t>> grid;
+  absl::flat_hash_map<std::pair<int64_t, int64_t>, std::vector<uint32_t>> grid;
   bool use_grid = index_circles && cell > 0 && std::isfinite(cell);
   for (uint32_t k : with_arcs) {
     if (!use_grid) break;
