@@ -2061,7 +2061,26 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
       }
     }
   }
+  // Cancellation and deadlines inside a round, as Run() polls between
+  // events: one COLLAR round can insert tens of thousands of points
+  // (fandisk.off: 49,892 repairs in round 9; a 900 s deadline ended the job
+  // at 963 s when only Run() polled).
+  uint64_t round_work = 0;
+  auto poll_round = [&](double radius) -> absl::Status {
+    if (round_work++ % options_.poll_interval != 0) return absl::OkStatus();
+    if (options_.poll) {
+      absl::Status s = options_.poll();
+      if (!s.ok()) return s;
+    }
+    if (options_.progress) options_.progress(TotalVertices(), queues_.size(), radius);
+    return absl::OkStatus();
+  };
+  {
+    absl::Status s = poll_round(reps.empty() ? 0.0 : reps.front().radius);
+    if (!s.ok()) return s;
+  }
   for (const CollarRepair& r : reps) {
+    if (absl::Status s = poll_round(r.radius); !s.ok()) return s;
     // A RepBall far below its collar's radius means the sampling of S is
     // chasing a degenerate configuration, not converging (measured on
     // schonhardt.off: ~500 topology repairs per round at radii 1e-7..1e-8
@@ -2154,6 +2173,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
       ++crossing_count_;
     }
     for (const ArcRepair& r : ar) {
+      if (absl::Status s = poll_round(r.radius); !s.ok()) return s;
       if (!(r.x.x >= m.SquareLo().x && r.x.x <= m.SquareHi().x && r.x.y >= m.SquareLo().y && r.x.y <= m.SquareHi().y)) continue;
       const VertexId2 w = m.dt().NearestVertex(r.x);
       const Vec2 pw = m.dt().Point(w);

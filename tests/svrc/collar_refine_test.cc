@@ -2,7 +2,9 @@
 // on PLCs with creases. Refinement must terminate under a vertex cap; every
 // collar radius is g/3 against a brute-force g over the complex's features;
 // balls centred on different creases are disjoint (Lemma 13).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <tuple>
@@ -405,5 +407,39 @@ TEST(CollarRefine, ReusedRoundWorkGivesTheSameRefinement) {
       ASSERT_TRUE(runs[0]->normalised_positions[i] == runs[1]->normalised_positions[i]) << c.rel << " point " << i;
     }
   }
+}
+
+// Cancellation and deadlines are polled inside the COLLAR rounds too, every
+// poll_interval repairs, with a progress report each time: a round can
+// insert tens of thousands of points (fandisk.off: a 900 s deadline ended
+// the job at 963 s when only Run() polled). With poll_interval 16, the
+// vertices added between two reports stay far below one round's repairs
+// (knife_edge.poly's round 0: ~230 points on S and ~200 on facet arcs).
+TEST(CollarRefine, CollarRoundsPollBetweenRepairs) {
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/knife_edge.poly"));
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+  ASSERT_TRUE(cx.ok()) << cx.status();
+  RefineOptions opt;
+  opt.collars = true;
+  opt.collar_surface = true;
+  opt.max_rep_angle = 60 * M_PI / 180;
+  opt.poll_interval = 16;
+  uint64_t polls = 0, last = 0, max_gap = 0;
+  opt.poll = [&] {
+    ++polls;
+    return absl::OkStatus();
+  };
+  opt.progress = [&](uint64_t vertices, uint64_t, double) {
+    if (last > 0) max_gap = std::max(max_gap, vertices - std::min(vertices, last));
+    last = vertices;
+  };
+  absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+  ASSERT_TRUE(run.ok()) << run.status();
+  EXPECT_GT(run->stats.collar_rounds, 3u);
+  EXPECT_GT(polls, 100u);
+  std::printf("polls %llu, most vertices between two reports %llu\n", static_cast<unsigned long long>(polls),
+              static_cast<unsigned long long>(max_gap));
+  EXPECT_LE(max_gap, 120u);
 }
 }  // namespace svrc::refine
