@@ -187,7 +187,8 @@ void CircleEdges(const Delaunay3& dt, const Circle3& circle, std::span<const Col
                  std::span<const uint32_t> both, double delta, std::vector<RestrictedEdge>* out) {
   Vec3 u, w;
   CircleFrame(circle, &u, &w);
-  std::vector<VertexId> nb, nbb;
+  std::vector<VertexId> nb, nbb;  // nbb: neighbours of nbb_of, fetched once per edge
+  VertexId nbb_of;
   for (uint32_t ia : both) {
     const VertexId va(ia);
     dt.Neighbors(va, &nb);
@@ -213,25 +214,17 @@ void CircleEdges(const Delaunay3& dt, const Circle3& circle, std::span<const Col
         // x too. This saves the walk (measured on hinge.stl: these walks
         // were 18% of the run). The margin 2e−12 covers the rounding of the
         // distances, so the accepted roots are exactly those of the walk.
-        const double dmin = std::min(geom::Dist(x, a), geom::Dist(x, b));
-        const double cut = dmin * (1 - 2e-12);
-        bool shown_off = false;
-        for (VertexId vw : nb) {
-          if (vw != vb && geom::Dist(x, dt.Point(vw)) < cut) {
-            shown_off = true;
-            break;
-          }
-        }
-        if (!shown_off) {
+        const double cut = std::min(geom::Dist(x, a), geom::Dist(x, b)) * (1 - 2e-12);
+        auto any_nearer = [&](std::span<const VertexId> ns, VertexId other) {
+          return std::any_of(ns.begin(), ns.end(),
+                             [&](VertexId vw) { return vw != other && geom::Dist(x, dt.Point(vw)) < cut; });
+        };
+        if (any_nearer(nb, vb)) continue;
+        if (nbb_of != vb) {
           dt.Neighbors(vb, &nbb);
-          for (VertexId vw : nbb) {
-            if (vw != va && geom::Dist(x, dt.Point(vw)) < cut) {
-              shown_off = true;
-              break;
-            }
-          }
+          nbb_of = vb;
         }
-        if (shown_off) continue;
+        if (any_nearer(nbb, va)) continue;
         const VertexId nv = dt.NearestVertex(x, dt.VertexTet(va));
         if (nv != va && nv != vb) {
           const double dn = geom::Dist(x, dt.Point(nv)), da = geom::Dist(x, a);
@@ -247,6 +240,11 @@ void CircleEdges(const Delaunay3& dt, const Circle3& circle, std::span<const Col
       }
     }
   }
+}
+
+// Ball b's term of css(x) (CollarSurfaceSize): ρ + max(0, |x c| − ρ).
+double CollarSizeTerm(const Vec3& x, const CollarBall& b) {
+  return b.radius + std::max(0.0, geom::Dist(x, b.center) - b.radius);
 }
 
 // Union-find over small dense ids.
@@ -358,9 +356,7 @@ bool IsOnePath(std::vector<std::pair<uint32_t, uint32_t>> edges) {
 
 double CollarSurfaceSize(const Vec3& x, const CollarDescription& collars) {
   double best = std::numeric_limits<double>::infinity();
-  for (const CollarBall& b : collars.balls) {
-    best = std::min(best, b.radius + std::max(0.0, geom::Dist(x, b.center) - b.radius));
-  }
+  for (const CollarBall& b : collars.balls) best = std::min(best, CollarSizeTerm(x, b));
   return best;
 }
 
@@ -893,14 +889,11 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       if (j != i && geom::Dist(balls[i].center, balls[j].center) < 3 * balls[i].radius) close[i].push_back(j);
     }
   }
-  auto contribution = [&](const Vec3& x, uint32_t j) {
-    return balls[j].radius + std::max(0.0, geom::Dist(x, balls[j].center) - balls[j].radius);
-  };
   auto css_at = [&](const Vec3& x, uint32_t o) {
-    const double b0 = contribution(x, o);
+    const double b0 = CollarSizeTerm(x, balls[o]);
     if (!(geom::Dist(x, balls[o].center) + b0 < 3 * balls[o].radius * (1 - 1e-9))) return CollarSurfaceSize(x, collars);
     double best = b0;
-    for (uint32_t j : close[o]) best = std::min(best, contribution(x, j));
+    for (uint32_t j : close[o]) best = std::min(best, CollarSizeTerm(x, balls[j]));
     return best;
   };
   for (const RestrictedTriangle& t : tris) {

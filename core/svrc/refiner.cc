@@ -291,6 +291,18 @@ class Refiner {
     if (attempt == 0 || attempt % 256 != 0 || !options_.poll) return absl::OkStatus();
     return options_.poll();
   }
+  // Run()'s poll between events and a COLLAR round's between repairs: at
+  // every poll_interval-th unit of work n, the poll, then a progress report
+  // (`radius`: the work about to be done).
+  absl::Status PollAt(uint64_t n, double radius) const {
+    if (n % options_.poll_interval != 0) return absl::OkStatus();
+    if (options_.poll) {
+      absl::Status s = options_.poll();
+      if (!s.ok()) return s;
+    }
+    if (options_.progress) options_.progress(TotalVertices(), queues_.size(), radius);
+    return absl::OkStatus();
+  }
   // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
   absl::Status Stitch() { return StitchImpl(); }
   void ClearStitch() {
@@ -1026,13 +1038,7 @@ absl::Status Refiner::Run() {
       return absl::ResourceExhaustedError(absl::StrCat(
           "SVRC: vertex budget of ", budget_, " reached with ", queues_.size(), " events pending"));
     }
-    if (destroys % options_.poll_interval == 0) {
-      if (options_.poll) {
-        absl::Status s = options_.poll();
-        if (!s.ok()) return s;
-      }
-      if (options_.progress) options_.progress(TotalVertices(), queues_.size(), event->radius);
-    }
+    if (absl::Status s = PollAt(destroys, event->radius); !s.ok()) return s;
     ++destroys;
     absl::Status s = Destroy(*event);
     if (!s.ok()) return s;
@@ -2066,21 +2072,9 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   // (fandisk.off: 49,892 repairs in round 9; a 900 s deadline ended the job
   // at 963 s when only Run() polled).
   uint64_t round_work = 0;
-  auto poll_round = [&](double radius) -> absl::Status {
-    if (round_work++ % options_.poll_interval != 0) return absl::OkStatus();
-    if (options_.poll) {
-      absl::Status s = options_.poll();
-      if (!s.ok()) return s;
-    }
-    if (options_.progress) options_.progress(TotalVertices(), queues_.size(), radius);
-    return absl::OkStatus();
-  };
-  {
-    absl::Status s = poll_round(reps.empty() ? 0.0 : reps.front().radius);
-    if (!s.ok()) return s;
-  }
+  if (absl::Status s = PollAt(round_work++, reps.empty() ? 0.0 : reps.front().radius); !s.ok()) return s;
   for (const CollarRepair& r : reps) {
-    if (absl::Status s = poll_round(r.radius); !s.ok()) return s;
+    if (absl::Status s = PollAt(round_work++, r.radius); !s.ok()) return s;
     // A RepBall far below its collar's radius means the sampling of S is
     // chasing a degenerate configuration, not converging (measured on
     // schonhardt.off: ~500 topology repairs per round at radii 1e-7..1e-8
@@ -2173,7 +2167,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
       ++crossing_count_;
     }
     for (const ArcRepair& r : ar) {
-      if (absl::Status s = poll_round(r.radius); !s.ok()) return s;
+      if (absl::Status s = PollAt(round_work++, r.radius); !s.ok()) return s;
       if (!(r.x.x >= m.SquareLo().x && r.x.x <= m.SquareHi().x && r.x.y >= m.SquareLo().y && r.x.y <= m.SquareHi().y)) continue;
       const VertexId2 w = m.dt().NearestVertex(r.x);
       const Vec2 pw = m.dt().Point(w);
@@ -2681,6 +2675,14 @@ bool Refiner::EnqueueMissing() {
     }
     return key;
   };
+  // Whether ball b's simplex is known inside the collars, or known in M_Ω
+  // with the same key; *key receives the current key unless inside.
+  auto known = [&](BallId b, std::span<const PointId> verts, uint64_t* key) {
+    const uint64_t k = known_present_[b.value()];
+    if (k == kInside) return true;
+    *key = key_of(verts);
+    return *key != 0 && k == *key;
+  };
   bool more = false;
   for (uint32_t sg = 0; sg < segs_.size(); ++sg) {
     SegmentMesh& m = segs_[sg];
@@ -2692,12 +2694,7 @@ bool Refiner::EnqueueMissing() {
       // segment of facets is always tested.
       const bool cacheable = piece.valid() && seg_facets_[sg].empty();
       uint64_t key = 0;
-      if (cacheable) {
-        uint64_t& known = known_present_[piece.value()];
-        if (known == kInside) continue;
-        key = key_of(ends);
-        if (key != 0 && known == key) continue;
-      }
+      if (cacheable && known(piece, ends, &key)) continue;
       if (options_.collars && InsideCollars(ends)) {
         if (cacheable) known_present_[piece.value()] = kInside;
         continue;
@@ -2718,13 +2715,11 @@ bool Refiner::EnqueueMissing() {
     for (TriId2 t : dt.Triangles()) {
       const BallId b = facets_[f].TriBall(t);
       if (!b.valid()) continue;
-      uint64_t& known = known_present_[b.value()];
-      if (known == kInside) continue;
       const std::array<PointId, 3> verts{balls_.Vertex(b, 0), balls_.Vertex(b, 1), balls_.Vertex(b, 2)};
-      const uint64_t key = key_of(verts);
-      if (key != 0 && known == key) continue;
+      uint64_t key = 0;
+      if (known(b, verts, &key)) continue;
       if (options_.collars && InsideCollars(verts)) {
-        known = kInside;
+        known_present_[b.value()] = kInside;
         continue;
       }
       if (!OmegaHasFace(verts[0], verts[1], verts[2])) {
@@ -2732,7 +2727,7 @@ bool Refiner::EnqueueMissing() {
         EnqueueEncroached(b);
         more = true;
       } else {
-        known = key;
+        known_present_[b.value()] = key;
       }
     }
   }

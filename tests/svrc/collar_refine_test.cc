@@ -3,8 +3,10 @@
 // collar radius is g/3 against a brute-force g over the complex's features;
 // balls centred on different creases are disjoint (Lemma 13).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <set>
 #include <tuple>
@@ -324,6 +326,47 @@ TEST(CollarRefineDebug, One) {
 }
 }
 namespace svrc::refine {
+// A corpus input refined twice, with `set(opt, false)` and `set(opt, true)`
+// (σ = 60°, collars on or off, max_volume), and the two refinements compared
+// bit for bit: tets and every point. The runs are returned for the callers'
+// own checks of what the switch did.
+struct SameRefinementCase {
+  const char* rel;
+  bool collars;
+  double max_volume;
+};
+std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase& c,
+                                                        const std::function<void(RefineOptions*, bool)>& set) {
+  std::array<PointSetRefinement, 2> out;
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.rel));
+  EXPECT_TRUE(plc.ok()) << c.rel << ": " << plc.status();
+  if (!plc.ok()) return out;
+  absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+  EXPECT_TRUE(cx.ok()) << cx.status();
+  if (!cx.ok()) return out;
+  for (int on = 0; on < 2; ++on) {
+    RefineOptions opt;
+    opt.collars = c.collars;
+    opt.collar_surface = c.collars;
+    opt.max_rep_angle = 60 * M_PI / 180;
+    opt.max_volume = c.max_volume;
+    set(&opt, on == 1);
+    absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+    EXPECT_TRUE(run.ok()) << c.rel << ": " << run.status();
+    if (!run.ok()) return out;
+    out[on] = *std::move(run);
+  }
+  EXPECT_EQ(out[0].tets, out[1].tets) << c.rel;
+  EXPECT_EQ(out[0].normalised_positions.size(), out[1].normalised_positions.size()) << c.rel;
+  for (size_t i = 0; i < std::min(out[0].normalised_positions.size(), out[1].normalised_positions.size()); ++i) {
+    if (!(out[0].normalised_positions[i] == out[1].normalised_positions[i])) {
+      ADD_FAILURE() << c.rel << " point " << i;
+      break;
+    }
+  }
+  return out;
+}
+
 // RefineOptions::certify_cells: ForceInsertOmega's certificates of good
 // cells must give Size()'s verdicts bit for bit, so the refinement is the
 // same with and without them. segment_fan.poly (collars, COLLAR rounds)
@@ -333,35 +376,12 @@ namespace svrc::refine {
 // 6617 output vertices); cube.poly with max_volume exercises size targets.
 TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
   if (kSanitized) GTEST_SKIP() << "release only";
-  struct Case {
-    const char* rel;
-    bool collars;
-    double max_volume;
-  };
-  for (const Case& c : {Case{"d_small_angles/segment_fan.poly", true, 0}, Case{"a_convex/cube.poly", false, 1e-4},
-                        Case{"b_internal/box_in_box.poly", false, 0}}) {
-    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.rel));
-    ASSERT_TRUE(plc.ok()) << c.rel << ": " << plc.status();
-    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
-    ASSERT_TRUE(cx.ok()) << cx.status();
-    absl::StatusOr<PointSetRefinement> runs[2] = {absl::UnknownError("not run"), absl::UnknownError("not run")};
-    for (int certify = 0; certify < 2; ++certify) {
-      RefineOptions opt;
-      opt.collars = c.collars;
-      opt.collar_surface = c.collars;
-      opt.max_rep_angle = 60 * M_PI / 180;
-      opt.max_volume = c.max_volume;
-      opt.certify_cells = certify == 1;
-      runs[certify] = RefinePlc(*cx, opt);
-      ASSERT_TRUE(runs[certify].ok()) << c.rel << ": " << runs[certify].status();
-    }
-    EXPECT_EQ(runs[0]->stats.sizes_certified, 0u) << c.rel;
-    EXPECT_GT(runs[1]->stats.sizes_certified, 1000u) << c.rel;
-    EXPECT_EQ(runs[0]->tets, runs[1]->tets) << c.rel;
-    ASSERT_EQ(runs[0]->normalised_positions.size(), runs[1]->normalised_positions.size()) << c.rel;
-    for (size_t i = 0; i < runs[0]->normalised_positions.size(); ++i) {
-      ASSERT_TRUE(runs[0]->normalised_positions[i] == runs[1]->normalised_positions[i]) << c.rel << " point " << i;
-    }
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"d_small_angles/segment_fan.poly", true, 0}, SameRefinementCase{"a_convex/cube.poly", false, 1e-4},
+        SameRefinementCase{"b_internal/box_in_box.poly", false, 0}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->certify_cells = on; });
+    EXPECT_EQ(runs[0].stats.sizes_certified, 0u) << c.rel;
+    EXPECT_GT(runs[1].stats.sizes_certified, 1000u) << c.rel;
   }
 }
 
@@ -373,38 +393,15 @@ TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
 // size rounds (each ends in EnqueueMissing).
 TEST(CollarRefine, ReusedRoundWorkGivesTheSameRefinement) {
   if (kSanitized) GTEST_SKIP() << "release only";
-  struct Case {
-    const char* rel;
-    bool collars;
-    double max_volume;
-  };
-  for (const Case& c : {Case{"c_creases/knife_edge.poly", true, 0}, Case{"d_small_angles/segment_fan.poly", true, 0},
-                        Case{"a_convex/cube.poly", false, 1e-4}}) {
-    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.rel));
-    ASSERT_TRUE(plc.ok()) << c.rel << ": " << plc.status();
-    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
-    ASSERT_TRUE(cx.ok()) << cx.status();
-    absl::StatusOr<PointSetRefinement> runs[2] = {absl::UnknownError("not run"), absl::UnknownError("not run")};
-    for (int reuse = 0; reuse < 2; ++reuse) {
-      RefineOptions opt;
-      opt.collars = c.collars;
-      opt.collar_surface = c.collars;
-      opt.max_volume = c.max_volume;
-      opt.max_rep_angle = 60 * M_PI / 180;
-      opt.reuse_round_work = reuse == 1;
-      runs[reuse] = RefinePlc(*cx, opt);
-      ASSERT_TRUE(runs[reuse].ok()) << c.rel << ": " << runs[reuse].status();
-    }
-    EXPECT_EQ(runs[0]->stats.collar_balls_reused, 0u) << c.rel;
-    EXPECT_EQ(runs[0]->stats.arc_facets_settled, 0u) << c.rel;
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"c_creases/knife_edge.poly", true, 0}, SameRefinementCase{"d_small_angles/segment_fan.poly", true, 0},
+        SameRefinementCase{"a_convex/cube.poly", false, 1e-4}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->reuse_round_work = on; });
+    EXPECT_EQ(runs[0].stats.collar_balls_reused, 0u) << c.rel;
+    EXPECT_EQ(runs[0].stats.arc_facets_settled, 0u) << c.rel;
     if (c.collars) {
-      EXPECT_GT(runs[1]->stats.collar_balls_reused, 0u) << c.rel;
-      EXPECT_GT(runs[1]->stats.collar_rounds, 3u) << c.rel;
-    }
-    EXPECT_EQ(runs[0]->tets, runs[1]->tets) << c.rel;
-    ASSERT_EQ(runs[0]->normalised_positions.size(), runs[1]->normalised_positions.size()) << c.rel;
-    for (size_t i = 0; i < runs[0]->normalised_positions.size(); ++i) {
-      ASSERT_TRUE(runs[0]->normalised_positions[i] == runs[1]->normalised_positions[i]) << c.rel << " point " << i;
+      EXPECT_GT(runs[1].stats.collar_balls_reused, 0u) << c.rel;
+      EXPECT_GT(runs[1].stats.collar_rounds, 3u) << c.rel;
     }
   }
 }
