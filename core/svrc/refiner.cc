@@ -89,7 +89,7 @@ double HalfLen2(Vec2 a, Vec2 b) { return 0.5 * std::hypot(a.x - b.x, a.y - b.y);
 class Refiner {
  public:
   Refiner(const RefineOptions& options, Normalization norm, const Vec3& center, double half)
-      : options_(options), norm_(norm), omega_(center, half) {}
+      : options_(options), norm_(norm), omega_(center, half), collar_snap_(options.collar_snap) {}
 
   absl::Status Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments);
   // Shared by both entry points: the complex's points are `normalised` (global
@@ -466,6 +466,7 @@ class Refiner {
   std::vector<std::array<uint32_t, 4>> stitched_;     // final tets (point ids) after RipStitchCollar
  public:
   StitchResult stitch_report_;
+  double collar_snap_ = 0;  // the COLLAR rounds' snap band (RefineOptions::collar_snap, then its fallback)
   CollarSurfaceReport surface_report_;
   uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, crossing_count_ = 0;
   // The COLLAR rounds' restricted Delaunay of S, per ball, reused across
@@ -1994,6 +1995,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   const CollarDescription desc = BuildCollarDescription(collars_.balls());
   CollarSurfaceOptions copt;
   copt.sigma = options_.max_rep_angle;
+  copt.delta = collar_snap_;
   surface_report_ = CollarSurfaceReport();
   if (!restriction_cache_.generation) {
     restriction_cache_.generation = [this](uint32_t v) { return omega_.CellGeneration(VertexId(v)); };
@@ -2080,6 +2082,13 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     // schonhardt.off: ~500 topology repairs per round at radii 1e-7..1e-8
     // for 70+ rounds): stop with a precise error instead of running on.
     const double ball_r = collars_.ball(r.ball).radius;
+    if (r.radius < kMinCollarRepairRatio * ball_r && collar_snap_ < options_.collar_snap_fallback) {
+      // The true angles chase a vertex close to S (RefineOptions::
+      // collar_snap): from here on the thesis' snap band; the points of this
+      // round stay, the next round tests the snapped angles.
+      collar_snap_ = options_.collar_snap_fallback;
+      return true;
+    }
     if (r.radius < kMinCollarRepairRatio * ball_r) {
       return absl::FailedPreconditionError(absl::StrCat(
           "SVRC: COLLAR ", kCollarRepairName[r.reason], " repair at (", r.x.x, ", ",
@@ -2955,6 +2964,25 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.collar_pairs", static_cast<double>(collar_pairs));
   out->Set("svrc.collar_pairs_not_smooth", static_cast<double>(collar_pairs_not_smooth));
   out->Set("svrc.collar_worst_smoothness", collar_worst_smoothness);
+  if (stitch_stars + stitch_books > 0) {
+    out->Set("svrc.stitch_stars", static_cast<double>(stitch_stars));
+    out->Set("svrc.stitch_books", static_cast<double>(stitch_books));
+    out->Set("svrc.star_sigma_max_deg", star_sigma_max_deg);
+    out->Set("svrc.star_eps_max", star_eps_max);
+    out->Set("svrc.star_gamma_max_deg", star_gamma_max_deg);
+    out->Set("svrc.max_star_base_deg", max_star_base_deg);
+    out->Set("svrc.max_star_radial_deg", max_star_radial_deg);
+    out->Set("svrc.book_sigma_max_deg", book_sigma_max_deg);
+    out->Set("svrc.book_eps_max", book_eps_max);
+    out->Set("svrc.book_alpha_max_deg", book_alpha_max_deg);
+    out->Set("svrc.max_book_ab_deg", max_book_ab_deg);
+    out->Set("svrc.max_book_side_deg", max_book_side_deg);
+    out->Set("svrc.collar_snap", collar_snap);
+    out->Set("svrc.stitch_bounded", static_cast<double>(stitch_bounded));
+    out->Set("svrc.stitch_violations", static_cast<double>(stitch_violations));
+    out->Set("svrc.max_bounded_dihedral_deg", max_bounded_dihedral_deg);
+    out->Set("svrc.max_unbounded_dihedral_deg", max_unbounded_dihedral_deg);
+  }
   out->Set("svrc.seconds_refine", seconds);
 }
 
@@ -3192,6 +3220,26 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   out.stats.collar_pairs = sm.intersecting;
   out.stats.collar_pairs_not_smooth = sm.not_smooth;
   out.stats.collar_worst_smoothness = sm.worst;
+  {
+    const StitchResult& st = refiner.stitch_report_;  // the last stitch, which succeeded
+    out.stats.stitch_stars = st.stars;
+    out.stats.stitch_books = st.books;
+    out.stats.star_sigma_max_deg = st.star_sigma_max_deg;
+    out.stats.star_eps_max = st.star_eps_max;
+    out.stats.star_gamma_max_deg = st.star_gamma_max_deg;
+    out.stats.max_star_base_deg = st.max_star_base_deg;
+    out.stats.max_star_radial_deg = st.max_star_radial_deg;
+    out.stats.book_sigma_max_deg = st.book_sigma_max_deg;
+    out.stats.book_eps_max = st.book_eps_max;
+    out.stats.book_alpha_max_deg = st.book_alpha_max_deg;
+    out.stats.max_book_ab_deg = st.max_book_ab_deg;
+    out.stats.max_book_side_deg = st.max_book_side_deg;
+    out.stats.collar_snap = refiner.collar_snap_;
+    out.stats.stitch_bounded = st.stars_bounded + st.books_bounded;
+    out.stats.stitch_violations = st.star_violations + st.book_violations;
+    out.stats.max_bounded_dihedral_deg = st.max_bounded_dihedral_deg;
+    out.stats.max_unbounded_dihedral_deg = st.max_unbounded_dihedral_deg;
+  }
   return out;
 }
 }  // namespace

@@ -103,6 +103,18 @@ struct RefineOptions {
   // σ: the largest representation angle of the collar surface (radians;
   // MeshParams::max_rep_angle).
   double max_rep_angle = 0.5235987755982988;
+  // Snap band of the partial spheres and circles, relative to their radius
+  // (thesis §3.1.2 δ): a vertex that near S counts as on S for the angle
+  // test only. The stitched tets use the true positions, so with δ > 0 they
+  // exceed σ where the sample of S is about as fine as δ·ρ (measured:
+  // knife_edge.poly's stars reach 84.8° at σ = 60° with δ = 0.02). The
+  // rounds start with collar_snap (0: the true angles, what the stars and
+  // books see); when a repair would need a point below the RepBall floor
+  // (vertices close to S chased down: wedge-1.smesh), the band becomes
+  // collar_snap_fallback for the rest of the run (RefineStats::collar_snap).
+  // docs/svrc-collars.md "Session 11".
+  double collar_snap = 0;
+  double collar_snap_fallback = 0.02;
   // Called at every poll: vertices in all meshes, pending events, radius of
   // the event about to be destroyed (the largest work radius). May be null.
   std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;
@@ -148,6 +160,18 @@ struct RefineStats {
   uint64_t collar_pairs = 0;       // collar balls whose spheres intersect (pairs)
   uint64_t collar_pairs_not_smooth = 0;  // of those, meeting below π/2 (Lemma 14)
   double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those
+  // The final RipStitchCollar's stars and books and their measured shape
+  // (StitchResult; docs/svrc-collars.md §1): largest representation angle,
+  // RepBall ratio ε, restricted-triangle plane angle γ / book angle α, and
+  // the largest dihedrals, degrees.
+  uint64_t stitch_stars = 0, stitch_books = 0;
+  double star_sigma_max_deg = 0, star_eps_max = 0, star_gamma_max_deg = 0;
+  double max_star_base_deg = 0, max_star_radial_deg = 0;
+  double book_sigma_max_deg = 0, book_eps_max = 0, book_alpha_max_deg = 0;
+  double max_book_ab_deg = 0, max_book_side_deg = 0;
+  double collar_snap = 0;          // the snap band δ in force at the end of the COLLAR rounds
+  uint64_t stitch_bounded = 0, stitch_violations = 0;  // stars + books meeting their theorem's premises; above it
+  double max_bounded_dihedral_deg = 0, max_unbounded_dihedral_deg = 0;
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar

@@ -693,12 +693,24 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     const uint32_t fa = bf.tet[(bf.f + 1) & 3], fb = bf.tet[(bf.f + 2) & 3], fc = bf.tet[(bf.f + 3) & 3];
     const Vec3 &a = P(fa), &b = P(fb), &c = P(fc);
     const CollarBall& ball = balls[bf.ball];
-    sig_max = std::max(sig_max, RepresentationAngle(geom::Cross(b - a, c - a), bf.x, ball.center));
-    eps_max = std::max(eps_max, geom::Dist(bf.x, a) / ball.radius);
-    gam_max = std::max({gam_max, PlaneAngle(a, b, c), PlaneAngle(b, c, a), PlaneAngle(c, a, b)});
+    const double sig = RepresentationAngle(geom::Cross(b - a, c - a), bf.x, ball.center);
+    const double eps = geom::Dist(bf.x, a) / ball.radius;
+    const double gam = std::max({PlaneAngle(a, b, c), PlaneAngle(b, c, a), PlaneAngle(c, a, b)});
+    sig_max = std::max(sig_max, sig);
+    eps_max = std::max(eps_max, eps);
+    gam_max = std::max(gam_max, gam);
     const StarDihedrals d = MeasureStar(ball.center, a, b, c);
     base_max = std::max(base_max, d.max_base);
     rad_max = std::max(rad_max, d.max_radial);
+    const StarBound own = StarDihedralBound(sig, eps, gam);
+    const double worst = std::max(d.max_base, d.max_radial) * kRadToDeg;
+    if (own.valid) {
+      ++res.stars_bounded;
+      if (d.max_base > own.base + 1e-9 || d.max_radial > own.radial + 1e-9) ++res.star_violations;
+      res.max_bounded_dihedral_deg = std::max(res.max_bounded_dihedral_deg, worst);
+    } else {
+      res.max_unbounded_dihedral_deg = std::max(res.max_unbounded_dihedral_deg, worst);
+    }
   }
   res.max_star_base_deg = base_max * kRadToDeg;
   res.max_star_radial_deg = rad_max * kRadToDeg;
@@ -715,14 +727,28 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
   for (const Book& bk : books) {
     const CreasePair& cp = pairs[bk.pair];
     const Vec3 &v = P(bk.tet[0]), &w = P(bk.tet[1]), &a = P(bk.tet[2]), &b = P(bk.tet[3]);
-    bs = std::max(bs, CircleRepresentationAngle(a, b, cp.circle, bk.x));
-    be = std::max(be, std::max(geom::Dist(bk.x, a), geom::Dist(bk.x, b)) / cp.circle.radius);
+    const double sig = CircleRepresentationAngle(a, b, cp.circle, bk.x);
+    const double eps = std::max(geom::Dist(bk.x, a), geom::Dist(bk.x, b)) / cp.circle.radius;
     const Vec3 m = 0.5 * (a + b);
-    ba = std::max(ba, AngleBetween(v - m, w - m));
+    const double alpha = AngleBetween(v - m, w - m);
+    bs = std::max(bs, sig);
+    be = std::max(be, eps);
+    ba = std::max(ba, alpha);
     const BookDihedrals d = MeasureBook(v, w, a, b);
     mab = std::max(mab, d.at_ab);
     mside = std::max(mside, d.max_side);
     maxis = std::max(maxis, d.at_axis);
+    const BookBound own = BookDihedralBound(sig, eps, alpha);
+    const double worst = std::max({d.at_ab, d.max_side, d.at_axis}) * kRadToDeg;
+    if (own.valid) {
+      ++res.books_bounded;
+      if (d.at_ab > own.at_ab + 1e-9 || d.max_side > own.side + 1e-9 || d.at_axis > own.axis + 1e-9) {
+        ++res.book_violations;
+      }
+      res.max_bounded_dihedral_deg = std::max(res.max_bounded_dihedral_deg, worst);
+    } else {
+      res.max_unbounded_dihedral_deg = std::max(res.max_unbounded_dihedral_deg, worst);
+    }
   }
   res.max_book_ab_deg = mab * kRadToDeg;
   res.max_book_side_deg = mside * kRadToDeg;

@@ -107,6 +107,13 @@ struct StitchResult {
   double book_sigma_max_deg = 0, book_eps_max = 0, book_alpha_max_deg = 0;
   bool book_bound_valid = false;
   double book_bound_ab_deg = 0, book_bound_side_deg = 0, book_bound_axis_deg = 0;
+  // Per tet: a star/book whose own σ, ε (and γ / α) meet its theorem's
+  // premises is "bounded"; a bounded tet with a dihedral above its own bound
+  // (1e-9 rad slack) is a violation — the derivation would be wrong. The
+  // largest dihedral of the bounded and of the other tets, degrees.
+  uint32_t stars_bounded = 0, star_violations = 0;
+  uint32_t books_bounded = 0, book_violations = 0;
+  double max_bounded_dihedral_deg = 0, max_unbounded_dihedral_deg = 0;
 };
 
 // Rip and stitch (see docs/svrc-collars.md "RipStitchCollar (stage f)"):
