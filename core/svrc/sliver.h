@@ -110,6 +110,7 @@ struct SliverStats {
   uint64_t rejected_radius_edge = 0;  // a new tet over the radius-edge bound
   uint64_t rejected_volume = 0;       // a new tet larger than its component's largest
   uint64_t rejected_no_gain = 0;      // legal, but no better than the tets it replaces
+  uint64_t rejected_crease_angle = 0; // would give a tet touching a crease a larger dihedral than it replaces
   uint64_t stuck = 0;                 // bad tets no flip improved (summed over passes)
   bool hit_flip_cap = false;
   double seconds = 0;
