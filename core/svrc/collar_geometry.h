@@ -157,4 +157,29 @@ struct BookBound {
 };
 BookBound BookDihedralBound(double sigma, double eps, double alpha);
 
+// The shape of RipStitchCollar's stars and books (StitchResult::shape, the
+// final stitch's in RefineStats::stitch): measured extremes (degrees) and the
+// bounds above at the measured extremes σ_max, ε_max, γ_max / α_max; the
+// bounds are monotone in each argument, so every tet's own bound is ≤ these.
+// Per tet: a star/book whose own σ, ε (and γ / α) meet its theorem's
+// premises is "bounded"; a bounded tet with a dihedral above its own bound
+// (1e-9 rad slack) is a violation — the derivation would be wrong. The
+// largest dihedral of the bounded and of the other tets, degrees.
+struct StitchShape {
+  double max_star_base_deg = 0, max_star_radial_deg = 0;
+  double star_sigma_max_deg = 0, star_eps_max = 0, star_gamma_max_deg = 0;
+  bool star_bound_valid = false;
+  double star_bound_base_deg = 0, star_bound_radial_deg = 0;
+  double max_book_ab_deg = 0, max_book_side_deg = 0, max_book_axis_deg = 0;
+  double book_sigma_max_deg = 0, book_eps_max = 0, book_alpha_max_deg = 0;
+  bool book_bound_valid = false;
+  double book_bound_ab_deg = 0, book_bound_side_deg = 0, book_bound_axis_deg = 0;
+  uint32_t stars_bounded = 0, star_violations = 0;
+  uint32_t books_bounded = 0, book_violations = 0;
+  double max_bounded_dihedral_deg = 0, max_unbounded_dihedral_deg = 0;
+
+  uint32_t bounded() const { return stars_bounded + books_bounded; }
+  uint32_t violations() const { return star_violations + book_violations; }
+};
+
 }  // namespace svrc::refine

@@ -2082,14 +2082,14 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     // schonhardt.off: ~500 topology repairs per round at radii 1e-7..1e-8
     // for 70+ rounds): stop with a precise error instead of running on.
     const double ball_r = collars_.ball(r.ball).radius;
-    if (r.radius < kMinCollarRepairRatio * ball_r && collar_snap_ < options_.collar_snap_fallback) {
-      // The true angles chase a vertex close to S (RefineOptions::
-      // collar_snap): from here on the thesis' snap band; the points of this
-      // round stay, the next round tests the snapped angles.
-      collar_snap_ = options_.collar_snap_fallback;
-      return true;
-    }
     if (r.radius < kMinCollarRepairRatio * ball_r) {
+      if (collar_snap_ < options_.collar_snap_fallback) {
+        // The true angles chase a vertex close to S (RefineOptions::
+        // collar_snap): from here on the thesis' snap band; the points of
+        // this round stay, the next round tests the snapped angles.
+        collar_snap_ = options_.collar_snap_fallback;
+        return true;
+      }
       return absl::FailedPreconditionError(absl::StrCat(
           "SVRC: COLLAR ", kCollarRepairName[r.reason], " repair at (", r.x.x, ", ",
           r.x.y, ", ", r.x.z, ") needs a point ", r.radius / ball_r, " collar radii from the nearest vertex; the ",
@@ -2967,21 +2967,21 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   if (stitch_stars + stitch_books > 0) {
     out->Set("svrc.stitch_stars", static_cast<double>(stitch_stars));
     out->Set("svrc.stitch_books", static_cast<double>(stitch_books));
-    out->Set("svrc.star_sigma_max_deg", star_sigma_max_deg);
-    out->Set("svrc.star_eps_max", star_eps_max);
-    out->Set("svrc.star_gamma_max_deg", star_gamma_max_deg);
-    out->Set("svrc.max_star_base_deg", max_star_base_deg);
-    out->Set("svrc.max_star_radial_deg", max_star_radial_deg);
-    out->Set("svrc.book_sigma_max_deg", book_sigma_max_deg);
-    out->Set("svrc.book_eps_max", book_eps_max);
-    out->Set("svrc.book_alpha_max_deg", book_alpha_max_deg);
-    out->Set("svrc.max_book_ab_deg", max_book_ab_deg);
-    out->Set("svrc.max_book_side_deg", max_book_side_deg);
+    out->Set("svrc.star_sigma_max_deg", stitch.star_sigma_max_deg);
+    out->Set("svrc.star_eps_max", stitch.star_eps_max);
+    out->Set("svrc.star_gamma_max_deg", stitch.star_gamma_max_deg);
+    out->Set("svrc.max_star_base_deg", stitch.max_star_base_deg);
+    out->Set("svrc.max_star_radial_deg", stitch.max_star_radial_deg);
+    out->Set("svrc.book_sigma_max_deg", stitch.book_sigma_max_deg);
+    out->Set("svrc.book_eps_max", stitch.book_eps_max);
+    out->Set("svrc.book_alpha_max_deg", stitch.book_alpha_max_deg);
+    out->Set("svrc.max_book_ab_deg", stitch.max_book_ab_deg);
+    out->Set("svrc.max_book_side_deg", stitch.max_book_side_deg);
     out->Set("svrc.collar_snap", collar_snap);
-    out->Set("svrc.stitch_bounded", static_cast<double>(stitch_bounded));
-    out->Set("svrc.stitch_violations", static_cast<double>(stitch_violations));
-    out->Set("svrc.max_bounded_dihedral_deg", max_bounded_dihedral_deg);
-    out->Set("svrc.max_unbounded_dihedral_deg", max_unbounded_dihedral_deg);
+    out->Set("svrc.stitch_bounded", static_cast<double>(stitch.bounded()));
+    out->Set("svrc.stitch_violations", static_cast<double>(stitch.violations()));
+    out->Set("svrc.max_bounded_dihedral_deg", stitch.max_bounded_dihedral_deg);
+    out->Set("svrc.max_unbounded_dihedral_deg", stitch.max_unbounded_dihedral_deg);
   }
   out->Set("svrc.seconds_refine", seconds);
 }
@@ -3220,26 +3220,11 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   out.stats.collar_pairs = sm.intersecting;
   out.stats.collar_pairs_not_smooth = sm.not_smooth;
   out.stats.collar_worst_smoothness = sm.worst;
-  {
-    const StitchResult& st = refiner.stitch_report_;  // the last stitch, which succeeded
-    out.stats.stitch_stars = st.stars;
-    out.stats.stitch_books = st.books;
-    out.stats.star_sigma_max_deg = st.star_sigma_max_deg;
-    out.stats.star_eps_max = st.star_eps_max;
-    out.stats.star_gamma_max_deg = st.star_gamma_max_deg;
-    out.stats.max_star_base_deg = st.max_star_base_deg;
-    out.stats.max_star_radial_deg = st.max_star_radial_deg;
-    out.stats.book_sigma_max_deg = st.book_sigma_max_deg;
-    out.stats.book_eps_max = st.book_eps_max;
-    out.stats.book_alpha_max_deg = st.book_alpha_max_deg;
-    out.stats.max_book_ab_deg = st.max_book_ab_deg;
-    out.stats.max_book_side_deg = st.max_book_side_deg;
-    out.stats.collar_snap = refiner.collar_snap_;
-    out.stats.stitch_bounded = st.stars_bounded + st.books_bounded;
-    out.stats.stitch_violations = st.star_violations + st.book_violations;
-    out.stats.max_bounded_dihedral_deg = st.max_bounded_dihedral_deg;
-    out.stats.max_unbounded_dihedral_deg = st.max_unbounded_dihedral_deg;
-  }
+  // The last stitch, which succeeded.
+  out.stats.stitch_stars = refiner.stitch_report_.stars;
+  out.stats.stitch_books = refiner.stitch_report_.books;
+  out.stats.stitch = refiner.stitch_report_.shape;
+  out.stats.collar_snap = refiner.collar_snap_;
   return out;
 }
 }  // namespace

@@ -18,6 +18,7 @@
 #include "core/geometry/vec3.h"
 #include "core/mesh/tet_mesh.h"
 #include "core/plc/features.h"
+#include "core/svrc/collar_geometry.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/labelling.h"
 
@@ -161,17 +162,10 @@ struct RefineStats {
   uint64_t collar_pairs_not_smooth = 0;  // of those, meeting below π/2 (Lemma 14)
   double collar_worst_smoothness = 0;    // largest |c₁c₂|² / (r₁² + r₂²) of those
   // The final RipStitchCollar's stars and books and their measured shape
-  // (StitchResult; docs/svrc-collars.md §1): largest representation angle,
-  // RepBall ratio ε, restricted-triangle plane angle γ / book angle α, and
-  // the largest dihedrals, degrees.
+  // (StitchResult; docs/svrc-collars.md §1).
   uint64_t stitch_stars = 0, stitch_books = 0;
-  double star_sigma_max_deg = 0, star_eps_max = 0, star_gamma_max_deg = 0;
-  double max_star_base_deg = 0, max_star_radial_deg = 0;
-  double book_sigma_max_deg = 0, book_eps_max = 0, book_alpha_max_deg = 0;
-  double max_book_ab_deg = 0, max_book_side_deg = 0;
+  StitchShape stitch;
   double collar_snap = 0;          // the snap band δ in force at the end of the COLLAR rounds
-  uint64_t stitch_bounded = 0, stitch_violations = 0;  // stars + books meeting their theorem's premises; above it
-  double max_bounded_dihedral_deg = 0, max_unbounded_dihedral_deg = 0;
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar

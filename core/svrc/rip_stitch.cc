@@ -705,23 +705,23 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     const StarBound own = StarDihedralBound(sig, eps, gam);
     const double worst = std::max(d.max_base, d.max_radial) * kRadToDeg;
     if (own.valid) {
-      ++res.stars_bounded;
-      if (d.max_base > own.base + 1e-9 || d.max_radial > own.radial + 1e-9) ++res.star_violations;
-      res.max_bounded_dihedral_deg = std::max(res.max_bounded_dihedral_deg, worst);
+      ++res.shape.stars_bounded;
+      if (d.max_base > own.base + 1e-9 || d.max_radial > own.radial + 1e-9) ++res.shape.star_violations;
+      res.shape.max_bounded_dihedral_deg = std::max(res.shape.max_bounded_dihedral_deg, worst);
     } else {
-      res.max_unbounded_dihedral_deg = std::max(res.max_unbounded_dihedral_deg, worst);
+      res.shape.max_unbounded_dihedral_deg = std::max(res.shape.max_unbounded_dihedral_deg, worst);
     }
   }
-  res.max_star_base_deg = base_max * kRadToDeg;
-  res.max_star_radial_deg = rad_max * kRadToDeg;
-  res.star_sigma_max_deg = sig_max * kRadToDeg;
-  res.star_eps_max = eps_max;
-  res.star_gamma_max_deg = gam_max * kRadToDeg;
+  res.shape.max_star_base_deg = base_max * kRadToDeg;
+  res.shape.max_star_radial_deg = rad_max * kRadToDeg;
+  res.shape.star_sigma_max_deg = sig_max * kRadToDeg;
+  res.shape.star_eps_max = eps_max;
+  res.shape.star_gamma_max_deg = gam_max * kRadToDeg;
   if (!faces.empty()) {
     const StarBound sb = StarDihedralBound(sig_max, eps_max, gam_max);
-    res.star_bound_valid = sb.valid;
-    res.star_bound_base_deg = sb.base * kRadToDeg;
-    res.star_bound_radial_deg = sb.radial * kRadToDeg;
+    res.shape.star_bound_valid = sb.valid;
+    res.shape.star_bound_base_deg = sb.base * kRadToDeg;
+    res.shape.star_bound_radial_deg = sb.radial * kRadToDeg;
   }
   double bs = 0, be = 0, ba = 0, mab = 0, mside = 0, maxis = 0;
   for (const Book& bk : books) {
@@ -741,27 +741,27 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     const BookBound own = BookDihedralBound(sig, eps, alpha);
     const double worst = std::max({d.at_ab, d.max_side, d.at_axis}) * kRadToDeg;
     if (own.valid) {
-      ++res.books_bounded;
+      ++res.shape.books_bounded;
       if (d.at_ab > own.at_ab + 1e-9 || d.max_side > own.side + 1e-9 || d.at_axis > own.axis + 1e-9) {
-        ++res.book_violations;
+        ++res.shape.book_violations;
       }
-      res.max_bounded_dihedral_deg = std::max(res.max_bounded_dihedral_deg, worst);
+      res.shape.max_bounded_dihedral_deg = std::max(res.shape.max_bounded_dihedral_deg, worst);
     } else {
-      res.max_unbounded_dihedral_deg = std::max(res.max_unbounded_dihedral_deg, worst);
+      res.shape.max_unbounded_dihedral_deg = std::max(res.shape.max_unbounded_dihedral_deg, worst);
     }
   }
-  res.max_book_ab_deg = mab * kRadToDeg;
-  res.max_book_side_deg = mside * kRadToDeg;
-  res.max_book_axis_deg = maxis * kRadToDeg;
-  res.book_sigma_max_deg = bs * kRadToDeg;
-  res.book_eps_max = be;
-  res.book_alpha_max_deg = ba * kRadToDeg;
+  res.shape.max_book_ab_deg = mab * kRadToDeg;
+  res.shape.max_book_side_deg = mside * kRadToDeg;
+  res.shape.max_book_axis_deg = maxis * kRadToDeg;
+  res.shape.book_sigma_max_deg = bs * kRadToDeg;
+  res.shape.book_eps_max = be;
+  res.shape.book_alpha_max_deg = ba * kRadToDeg;
   if (!books.empty()) {
     const BookBound bb = BookDihedralBound(bs, be, ba);
-    res.book_bound_valid = bb.valid;
-    res.book_bound_ab_deg = bb.at_ab * kRadToDeg;
-    res.book_bound_side_deg = bb.side * kRadToDeg;
-    res.book_bound_axis_deg = bb.axis * kRadToDeg;
+    res.shape.book_bound_valid = bb.valid;
+    res.shape.book_bound_ab_deg = bb.at_ab * kRadToDeg;
+    res.shape.book_bound_side_deg = bb.side * kRadToDeg;
+    res.shape.book_bound_axis_deg = bb.axis * kRadToDeg;
   }
   for (const BoundaryFace& bf : faces) {
     std::array<uint32_t, 4> star = bf.tet;

@@ -96,24 +96,8 @@ struct StitchResult {
   uint32_t books = 0;
   uint32_t crease_edges_without_circle = 0;  // listed pairs whose spheres do not cross
 
-  // Measured extremes (degrees) and the doc's bounds (collar_geometry.h) at
-  // the measured extremes σ_max, ε_max, γ_max / α_max; the bounds are monotone
-  // in each argument, so every tet's own (per-tet) bound is ≤ these.
-  double max_star_base_deg = 0, max_star_radial_deg = 0;
-  double star_sigma_max_deg = 0, star_eps_max = 0, star_gamma_max_deg = 0;
-  bool star_bound_valid = false;
-  double star_bound_base_deg = 0, star_bound_radial_deg = 0;
-  double max_book_ab_deg = 0, max_book_side_deg = 0, max_book_axis_deg = 0;
-  double book_sigma_max_deg = 0, book_eps_max = 0, book_alpha_max_deg = 0;
-  bool book_bound_valid = false;
-  double book_bound_ab_deg = 0, book_bound_side_deg = 0, book_bound_axis_deg = 0;
-  // Per tet: a star/book whose own σ, ε (and γ / α) meet its theorem's
-  // premises is "bounded"; a bounded tet with a dihedral above its own bound
-  // (1e-9 rad slack) is a violation — the derivation would be wrong. The
-  // largest dihedral of the bounded and of the other tets, degrees.
-  uint32_t stars_bounded = 0, star_violations = 0;
-  uint32_t books_bounded = 0, book_violations = 0;
-  double max_bounded_dihedral_deg = 0, max_unbounded_dihedral_deg = 0;
+  // The stars' and books' measured shape and the doc's bounds (§1).
+  StitchShape shape;
 };
 
 // Rip and stitch (see docs/svrc-collars.md "RipStitchCollar (stage f)"):

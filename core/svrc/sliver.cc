@@ -192,6 +192,7 @@ class FlipMesh {
   // new_min > max(floor, their own old_min). False if none.
   bool BestFlip(uint32_t t, double floor, Flip* best);
   bool RaisesCreaseAngle(const Flip& f) const;
+  bool TouchesCrease(const Tet& t) const;  // a vertex flagged in options_.crease_vertex (non-empty)
   void Apply(const Flip& flip, std::vector<uint32_t>* created, Journal* journal);
   void Count(const Flip& flip);
   // Search for a stuck tet t: flips of nearby tets (not t) whose new tets are
@@ -480,9 +481,7 @@ FlipMesh::Reject FlipMesh::NewTet(const Tet& t, double re_bound, double volume_b
   if (geom::Orient3d(pos_[t[0]], pos_[t[1]], pos_[t[2]], pos_[t[3]]) <= 0) return kOrientation;
   *q = MeasureBoundsOnly(pos_, t);
   if (!(q->radius_edge <= re_bound)) return kRadiusEdge;
-  if (!options_.crease_vertex.empty() && q->radius_edge > options_.max_radius_edge &&
-      !(options_.crease_vertex[t[0]] || options_.crease_vertex[t[1]] || options_.crease_vertex[t[2]] ||
-        options_.crease_vertex[t[3]])) {
+  if (!options_.crease_vertex.empty() && q->radius_edge > options_.max_radius_edge && !TouchesCrease(t)) {
     return kRadiusEdge;
   }
   if (options_.keep_max_volume && !(q->volume <= volume_bound)) return kVolume;
@@ -664,15 +663,17 @@ void FlipMesh::ForEachFlip(uint32_t t, Fn&& fn) {
 // largest of the tets it replaces (measured before this test: crease_pair
 // 10°'s largest dihedral next to the creases went from 156.4° stitched to
 // 165.4° after the flips).
+bool FlipMesh::TouchesCrease(const Tet& t) const {
+  const std::vector<uint8_t>& c = options_.crease_vertex;
+  return c[t[0]] || c[t[1]] || c[t[2]] || c[t[3]];
+}
+
 bool FlipMesh::RaisesCreaseAngle(const Flip& f) const {
   if (options_.crease_vertex.empty()) return false;
   double old_max = 0;
   for (int i = 0; i < f.num_old; ++i) old_max = std::max(old_max, quality_[f.old_tets[i]].max_dihedral);
   for (int i = 0; i < f.num_new; ++i) {
-    const Tet& t = f.new_tets[i];
-    const bool crease = options_.crease_vertex[t[0]] || options_.crease_vertex[t[1]] ||
-                        options_.crease_vertex[t[2]] || options_.crease_vertex[t[3]];
-    if (crease && f.new_quality[i].max_dihedral > old_max) return true;
+    if (f.new_quality[i].max_dihedral > old_max && TouchesCrease(f.new_tets[i])) return true;
   }
   return false;
 }

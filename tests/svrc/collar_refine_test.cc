@@ -468,19 +468,20 @@ TEST(CollarRefine, StitchedTetsMeetTheirDihedralBounds) {
       absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
       ASSERT_TRUE(run.ok()) << rel << ": " << run.status();
       const RefineStats& st = run->stats;
-      std::printf("%s snap %g: %llu stars, %llu books, %llu within the premises (largest dihedral %.2f), others %.2f; "
+      const StitchShape& sh = st.stitch;
+      std::printf("%s snap %g: %llu stars, %llu books, %u within the premises (largest dihedral %.2f), others %.2f; "
                   "star sigma %.2f eps %.3f gamma %.2f, dihedral base %.2f radial %.2f; book sigma %.2f\n",
                   rel, snap, static_cast<unsigned long long>(st.stitch_stars),
-                  static_cast<unsigned long long>(st.stitch_books), static_cast<unsigned long long>(st.stitch_bounded),
-                  st.max_bounded_dihedral_deg, st.max_unbounded_dihedral_deg, st.star_sigma_max_deg, st.star_eps_max,
-                  st.star_gamma_max_deg, st.max_star_base_deg, st.max_star_radial_deg, st.book_sigma_max_deg);
+                  static_cast<unsigned long long>(st.stitch_books), sh.bounded(), sh.max_bounded_dihedral_deg,
+                  sh.max_unbounded_dihedral_deg, sh.star_sigma_max_deg, sh.star_eps_max, sh.star_gamma_max_deg,
+                  sh.max_star_base_deg, sh.max_star_radial_deg, sh.book_sigma_max_deg);
       EXPECT_GT(st.stitch_stars, 1000u) << rel;
-      EXPECT_GT(st.stitch_bounded, (st.stitch_stars + st.stitch_books) * 9 / 10) << rel << " snap " << snap;
-      EXPECT_EQ(st.stitch_violations, 0u) << rel << " snap " << snap;
+      EXPECT_GT(sh.bounded(), (st.stitch_stars + st.stitch_books) * 9 / 10) << rel << " snap " << snap;
+      EXPECT_EQ(sh.violations(), 0u) << rel << " snap " << snap;
       EXPECT_EQ(st.collar_snap, snap) << rel << ": the rounds fell back to the snap band";
       if (snap == 0) {
-        EXPECT_LE(st.star_sigma_max_deg, 60 + 1e-9) << rel;
-        EXPECT_LE(st.book_sigma_max_deg, 60 + 1e-9) << rel;
+        EXPECT_LE(sh.star_sigma_max_deg, 60 + 1e-9) << rel;
+        EXPECT_LE(sh.book_sigma_max_deg, 60 + 1e-9) << rel;
       }
     }
   }

@@ -83,14 +83,14 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what) {
   // own dihedral bound (docs/svrc-collars.md §1; the stitch counts them).
   // (Creases of 45° and more are refined through without collars.)
   const mesh::MeshStats& st = m->stats;
+  const double stitched_max =
+      std::max(st.Get("svrc.max_bounded_dihedral_deg"), st.Get("svrc.max_unbounded_dihedral_deg"));
   if (st.Get("svrc.collars") > 0) {
     EXPECT_GT(st.Get("svrc.stitch_stars"), 0) << what;
     EXPECT_EQ(st.Get("svrc.stitch_violations", -1), 0) << what;
     // The sliver flips keep the stitch's largest dihedral next to the creases
     // (they made crease_pair 10°'s 156.4° into 165.4° before session 11).
-    EXPECT_LE(out.quality.crease.dihedral_deg.max,
-              std::max(st.Get("svrc.max_bounded_dihedral_deg"), st.Get("svrc.max_unbounded_dihedral_deg")) + 1e-6)
-        << what;
+    EXPECT_LE(out.quality.crease.dihedral_deg.max, stitched_max + 1e-6) << what;
     // The true representation angles are tested unless the rounds fell back
     // to the snap band (svrc.collar_snap > 0): every star and book within σ
     // (MeshParams' default 60°), the σ of the bounds.
@@ -105,9 +105,7 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what) {
               what.c_str(), out.tets, out.quality.other.num_tets, out.quality.other.radius_edge.max,
               out.quality.other.dihedral_deg.min, out.quality.other.dihedral_deg.max, out.quality.crease.num_tets,
               out.quality.crease.dihedral_deg.max, st.Get("svrc.collar_snap"), st.Get("svrc.star_sigma_max_deg"),
-              st.Get("svrc.book_sigma_max_deg"),
-              std::max(st.Get("svrc.max_bounded_dihedral_deg"), st.Get("svrc.max_unbounded_dihedral_deg")),
-              st.Get("svrc.stitch_bounded"), st.Get("svrc.stitch_stars") + st.Get("svrc.stitch_books"));
+              st.Get("svrc.book_sigma_max_deg"), stitched_max, st.Get("svrc.stitch_bounded"), st.Get("svrc.stitch_stars") + st.Get("svrc.stitch_books"));
   return out;
 }
 

@@ -269,27 +269,27 @@ void CheckMesh(const Scene& s, const StitchResult& r, const char* name) {
   }
   // Dihedral maxima within the doc's bounds (Theorems 1–2) at the measured σ, ε, γ/α.
   EXPECT_GT(r.stars, 0u);
-  EXPECT_TRUE(r.star_bound_valid) << name;
-  EXPECT_LE(r.max_star_base_deg, r.star_bound_base_deg) << name;
-  EXPECT_LE(r.max_star_radial_deg, r.star_bound_radial_deg) << name;
+  EXPECT_TRUE(r.shape.star_bound_valid) << name;
+  EXPECT_LE(r.shape.max_star_base_deg, r.shape.star_bound_base_deg) << name;
+  EXPECT_LE(r.shape.max_star_radial_deg, r.shape.star_bound_radial_deg) << name;
   if (r.books > 0) {
-    EXPECT_TRUE(r.book_bound_valid) << name;
-    EXPECT_LE(r.max_book_ab_deg, r.book_bound_ab_deg) << name;
-    EXPECT_LE(r.max_book_side_deg, r.book_bound_side_deg) << name;
-    EXPECT_LE(r.max_book_axis_deg, r.book_bound_axis_deg) << name;
+    EXPECT_TRUE(r.shape.book_bound_valid) << name;
+    EXPECT_LE(r.shape.max_book_ab_deg, r.shape.book_bound_ab_deg) << name;
+    EXPECT_LE(r.shape.max_book_side_deg, r.shape.book_bound_side_deg) << name;
+    EXPECT_LE(r.shape.max_book_axis_deg, r.shape.book_bound_axis_deg) << name;
   }
   std::printf(
       "%s: %zu tets (%u outside, %u inside removed, %u stars, %u books), %zu vertices removed\n"
       "  stars: max base %.2f° (bound %.2f°), max radial %.2f° (bound %.2f°); σmax %.2f° εmax %.3f γmax %.2f°\n",
       name, r.tets.size(), r.outside_tets, r.inside_tets, r.stars, r.books, r.removed_vertices.size(),
-      r.max_star_base_deg, r.star_bound_base_deg, r.max_star_radial_deg, r.star_bound_radial_deg,
-      r.star_sigma_max_deg, r.star_eps_max, r.star_gamma_max_deg);
+      r.shape.max_star_base_deg, r.shape.star_bound_base_deg, r.shape.max_star_radial_deg, r.shape.star_bound_radial_deg,
+      r.shape.star_sigma_max_deg, r.shape.star_eps_max, r.shape.star_gamma_max_deg);
   if (r.books > 0) {
     std::printf(
         "  books: max at ab %.2f° (bound %.2f°), max side %.2f° (bound %.2f°), max at axis %.2f° (bound %.2f°); "
         "σmax %.2f° εmax %.3f αmax %.2f°\n",
-        r.max_book_ab_deg, r.book_bound_ab_deg, r.max_book_side_deg, r.book_bound_side_deg, r.max_book_axis_deg,
-        r.book_bound_axis_deg, r.book_sigma_max_deg, r.book_eps_max, r.book_alpha_max_deg);
+        r.shape.max_book_ab_deg, r.shape.book_bound_ab_deg, r.shape.max_book_side_deg, r.shape.book_bound_side_deg, r.shape.max_book_axis_deg,
+        r.shape.book_bound_axis_deg, r.shape.book_sigma_max_deg, r.shape.book_eps_max, r.shape.book_alpha_max_deg);
   }
 }
 
