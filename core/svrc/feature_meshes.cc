@@ -123,14 +123,33 @@ CellSize OmegaMesh::Size(VertexId v) const {
     if (m.clipped) ++stats_.clipped_queries;
     return m;
   }
-  const CellSize out = ComputeSize(v);
+  bool unique = false;
+  const CellSize out = ComputeSize(v, &unique);
   if (size_memo_.size() <= v.value()) size_memo_.resize(dt_.NumVertices() + dt_.NumVertices() / 2 + 16);
-  size_memo_[v.value()] = {key, out};
+  size_memo_[v.value()] = {key, out, out.hint.valid() ? dt_.Generation(out.hint) : 0, unique};
   return out;
 }
 
-CellSize OmegaMesh::ComputeSize(VertexId v) const {
+bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, uint32_t new_tets, double new_corner, CellSize* out) const {
+  if (v.value() >= size_memo_.size()) return false;
+  SizeMemo& m = size_memo_[v.value()];
+  const uint32_t key = dt_.StarVersion(v) + 1;
+  if (m.key == 0 || m.key + new_tets != key || !m.unique || m.size.clipped || m.size.saw_flat) return false;
+  if (!(new_corner < m.size.outradius) || !m.size.hint.valid() || !dt_.IsAlive(m.size.hint) ||
+      dt_.Generation(m.size.hint) != m.hint_gen) {
+    return false;
+  }
+  ++stats_.size_queries;
+  ++stats_.shrunk_sizes;
+  m.key = key;
+  m.size.inradius = std::min(m.size.inradius, 0.5 * std::sqrt(geom::Dist2(dt_.Point(v), p)));
+  *out = m.size;
+  return true;
+}
+
+CellSize OmegaMesh::ComputeSize(VertexId v, bool* unique) const {
   CellSize out;
+  *unique = false;
   const Vec3& pv = dt_.Point(v);
   out.hint = dt_.VertexTet(v);
   // One star walk gives the star, the neighbours and, per neighbour, a tet on
@@ -161,6 +180,9 @@ CellSize OmegaMesh::ComputeSize(VertexId v) const {
       best = d;
       out.corner = e.cc;
       out.hint = t;
+      *unique = true;
+    } else if (d == best) {
+      *unique = false;
     }
   }
   if (!needs_clip) {
@@ -168,6 +190,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v) const {
     return out;
   }
   // Clip every Voronoi facet of v (dual to edge vu) to the cube.
+  *unique = false;
   ++stats_.clipped_queries;
   out.clipped = true;
   out.hint = dt_.VertexTet(v);

@@ -62,6 +62,15 @@ class OmegaMesh {
   // cube (Sutherland–Hodgman). Corners created on a cube face get that face's
   // coordinate exactly, so they lie on ∂Ω.
   CellSize Size(VertexId v) const;
+  // Size(v) right after an insertion next to v, from v's memo of the star
+  // before it, without a star walk: when the only change to v's star since
+  // the memo is this insertion (`new_tets` new tets at v), the memo's cell
+  // was unclipped with no flat tet and a unique farthest corner whose tet
+  // survived, and every new tet at v is plain with |cc − v| < R_v
+  // (`new_corner`, their largest). Then R_v, the corner and the hint stay
+  // (V(v) only shrank) and r_v = min(r_v, |vp|/2) (Lemma 3) — the doubles
+  // Size() would compute, so the verdicts do not change. False: call Size().
+  bool ShrunkSize(VertexId v, const geom::Vec3& p, uint32_t new_tets, double new_corner, CellSize* out) const;
   // The circumcentre of finite tet t as Size() reads it for each vertex of t
   // (R_v is the largest |cc − v| over v's star); false when Size() would not
   // read it plainly: t flat, or its circumcentre outside Ω (clipped cells).
@@ -80,12 +89,14 @@ class OmegaMesh {
   struct Stats {
     uint64_t size_queries = 0;
     uint64_t clipped_queries = 0;
+    uint64_t shrunk_sizes = 0;  // ShrunkSize() answers
   };
   const Stats& stats() const { return stats_; }
 
  private:
   bool InsideCube(const geom::Vec3& p) const;
-  CellSize ComputeSize(VertexId v) const;  // Size() without the memo
+  // Size() without the memo; *unique: no other star tet is as far as the corner's.
+  CellSize ComputeSize(VertexId v, bool* unique) const;
   // Appends the polygon clipped to the cube to `out` (vertices only).
   void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
   // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
@@ -122,6 +133,8 @@ class OmegaMesh {
   struct SizeMemo {
     uint32_t key = 0;  // StarVersion + 1 when computed; 0: none
     CellSize size;
+    uint32_t hint_gen = 0;  // Generation(size.hint) when computed
+    bool unique = false;    // ComputeSize's *unique
   };
   mutable std::vector<SizeMemo> size_memo_;
   // Scratch.

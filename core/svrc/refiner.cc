@@ -554,6 +554,7 @@ class Refiner {
   std::vector<CellCert> cell_cert_;
   std::vector<TetId> created_;
   std::vector<double> new_corner_;
+  std::vector<uint32_t> new_tets_;  // new tets at each cell of 𝒱 (ShrunkSize)
   std::vector<uint32_t> cert_mark_, cert_pos_;
   uint32_t cert_stamp_ = 0;
   std::vector<uint8_t> drop_;          // UpdateLocation: links of a shrunk cell to remove
@@ -1404,30 +1405,41 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // Largest |cc − u| over the new tets at each old cavity vertex u (+inf if
   // one of them is a ghost, flat, or has its circumcentre outside Ω).
   new_corner_.assign(changed.size(), 0.0);
+  new_tets_.assign(changed.size(), 0);
   for (TetId t : created_) {
     Vec3 cc;
     const bool plain = !dt.IsGhost(t) && omega_.PlainCorner(t, &cc);
     for (int k = 0; k < 4; ++k) {
       const VertexId u = dt.TetVertex(t, k);
       if (u == nv || !u.valid() || u.value() >= nvert || cert_mark_[u.value()] != cert_stamp_) continue;
+      ++new_tets_[cert_pos_[u.value()]];
       double& m = new_corner_[cert_pos_[u.value()]];
       m = plain ? std::max(m, geom::Dist(cc, dt.Point(u))) : HUGE_VAL;
     }
   }
   std::vector<CellSize> sizes(changed.size());
   std::vector<uint8_t> exact(changed.size(), 1);
-  auto exact_size = [&](size_t i) {
+  auto set_size = [&](size_t i) {
     const VertexId u = changed[i];
-    sizes[i] = omega_.Size(u);
     exact[i] = 1;
     cell_cert_[u.value()] = {sizes[i].inradius, sizes[i].outradius,
                              !sizes[i].clipped && !sizes[i].saw_flat && !IsBad(u, sizes[i])};
   };
+  auto exact_size = [&](size_t i) {
+    sizes[i] = omega_.Size(changed[i]);
+    set_size(i);
+  };
   for (size_t i = 0; i < changed.size(); ++i) {
     const VertexId u = changed[i];
-    if (i + 1 < changed.size()) {
+    if (i + 1 < changed.size() && options_.certify_cells) {
+      // Exact without a star walk when u's farthest corner survived (this
+      // also keeps u's memo current for the next insertion next to it).
+      if (omega_.ShrunkSize(u, pos, new_tets_[i], new_corner_[i], &sizes[i])) {
+        set_size(i);
+        continue;
+      }
       CellCert& cert = cell_cert_[u.value()];
-      if (cert.valid && options_.certify_cells) {
+      if (cert.valid) {
         const double r = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
         const double m = new_corner_[i];
         const bool target = u.value() < size_target_.size();
@@ -2810,6 +2822,7 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.links_added = blg_.stats().links_added;
   st.links_removed = blg_.stats().links_removed;
   st.clipped_cells = omega_.stats().clipped_queries;
+  st.sizes_shrunk = omega_.stats().shrunk_sizes;
 }
 
 PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
@@ -2924,6 +2937,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.insertions", static_cast<double>(insertions));
   out->Set("svrc.sizes_certified", static_cast<double>(sizes_certified));
   out->Set("svrc.sizes_uncertified", static_cast<double>(sizes_uncertified));
+  out->Set("svrc.sizes_shrunk", static_cast<double>(sizes_shrunk));
   out->Set("svrc.destroys_local", static_cast<double>(destroys_local));
   out->Set("svrc.warps", static_cast<double>(warps));
   out->Set("svrc.yields", static_cast<double>(yields));

@@ -30,8 +30,9 @@ struct RefineOptions {
   double tau = 4.0;
   // ForceInsertOmega proves most cavity cells still good from their last
   // Size() and the new tets (refiner.cc, cell_cert_) instead of walking their
-  // stars. false: Size() for every cavity cell, the reference the
-  // certificates must reproduce bit for bit (tests).
+  // stars, and sizes exactly the cells whose farthest corner survived from
+  // their memo (OmegaMesh::ShrunkSize). false: Size() for every cavity cell,
+  // the reference both must reproduce bit for bit (tests).
   bool certify_cells = true;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
@@ -183,6 +184,7 @@ struct RefineStats {
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
+  uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)
   uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)
   uint64_t predicate_calls = 0;
   uint64_t predicate_exact = 0;    // filter failures → exact arithmetic

@@ -1,0 +1,123 @@
+// M_Ω's cell sizes (core/svrc/feature_meshes.h): OmegaMesh::ShrunkSize, the
+// star-walk-free size of a cavity cell after an insertion, must equal Size()
+// computed from scratch bit for bit (the refiner's verdicts and output
+// depend on it), including on a lattice where farthest corners tie.
+#include <bit>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "core/svrc/feature_meshes.h"
+#include "gtest/gtest.h"
+
+namespace svrc::refine {
+namespace {
+
+using geom::Vec3;
+
+bool SameBits(double a, double b) { return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b); }
+
+struct Counts {
+  size_t shrunk = 0;
+  size_t cavity_cells = 0;
+};
+
+// Inserts `pts` into two copies of M_Ω. In `a`, every cavity cell is sized
+// by ShrunkSize when it answers (Size() otherwise, which keeps its memo
+// current, as ForceInsertOmega does); in `b`, always by Size() on a star it
+// has never seen. Every answer of `a` must equal `b`'s.
+Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third) {
+  OmegaMesh a(Vec3{0.5, 0.5, 0.5}, 2.0), b(Vec3{0.5, 0.5, 0.5}, 2.0);
+  std::array<PointId, 8> corners;
+  for (uint32_t i = 0; i < 8; ++i) corners[i] = PointId(i);
+  a.SeedCorners(corners);
+  b.SeedCorners(corners);
+  Counts out;
+  std::vector<uint32_t> pos(pts.size() + 16, UINT32_MAX);
+  for (size_t n = 0; n < pts.size(); ++n) {
+    const PointId id(static_cast<uint32_t>(8 + n));
+    const auto ra = a.dt().Insert(pts[n], id.value());
+    const auto rb = b.dt().Insert(pts[n], id.value());
+    EXPECT_EQ(ra.vertex, rb.vertex);
+    a.AddVertex(ra.vertex, id);
+    b.AddVertex(rb.vertex, id);
+    const std::vector<VertexId> cav(ra.cavity_vertices.begin(), ra.cavity_vertices.end());
+    std::vector<uint32_t> new_tets(cav.size(), 0);
+    std::vector<double> corner(cav.size(), 0.0);
+    for (size_t i = 0; i < cav.size(); ++i) pos[cav[i].value()] = static_cast<uint32_t>(i);
+    for (delaunay::TetId t : ra.created) {
+      Vec3 cc;
+      const bool plain = !a.dt().IsGhost(t) && a.PlainCorner(t, &cc);
+      for (int k = 0; k < 4; ++k) {
+        const VertexId u = a.dt().TetVertex(t, k);
+        if (u == ra.vertex || u.value() >= pos.size() || pos[u.value()] == UINT32_MAX) continue;
+        const uint32_t i = pos[u.value()];
+        ++new_tets[i];
+        corner[i] = plain ? std::max(corner[i], geom::Dist(cc, a.dt().Point(u))) : HUGE_VAL;
+      }
+    }
+    for (size_t i = 0; i < cav.size(); ++i) {
+      const VertexId u = cav[i];
+      pos[u.value()] = UINT32_MAX;
+      ++out.cavity_cells;
+      // Leave some cells unsized: their memo goes stale, and ShrunkSize
+      // must notice the star changes it did not see.
+      if (skip_every_third && (n + i) % 3 == 0) continue;
+      CellSize sa;
+      const bool shrunk = a.ShrunkSize(u, pts[n], new_tets[i], corner[i], &sa);
+      if (shrunk) {
+        ++out.shrunk;
+      } else {
+        sa = a.Size(u);
+      }
+      const CellSize sb = b.Size(u);
+      EXPECT_TRUE(SameBits(sa.outradius, sb.outradius)) << "vertex " << u.value() << " after point " << n;
+      EXPECT_TRUE(SameBits(sa.inradius, sb.inradius)) << "vertex " << u.value() << " after point " << n;
+      for (int k = 0; k < 3; ++k) EXPECT_TRUE(SameBits(sa.corner[k], sb.corner[k]));
+      EXPECT_EQ(sa.hint, sb.hint);
+      EXPECT_EQ(sa.clipped, sb.clipped);
+      EXPECT_EQ(sa.saw_flat, sb.saw_flat);
+      if (testing::Test::HasFailure()) return out;
+    }
+    a.Size(ra.vertex);
+    b.Size(rb.vertex);
+  }
+  return out;
+}
+
+TEST(OmegaMeshTest, ShrunkSizeEqualsSizeOnRandomPoints) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3> pts(3000);
+  for (Vec3& p : pts) p = {u(rng), u(rng), u(rng)};
+  const Counts c = CompareSizes(pts, false);
+  // Most cavity cells keep their farthest corner: the shortcut must answer
+  // often, or the refiner gains nothing.
+  EXPECT_GT(c.shrunk, c.cavity_cells / 5) << c.shrunk << " of " << c.cavity_cells;
+}
+
+TEST(OmegaMeshTest, ShrunkSizeNoticesStaleMemos) {
+  std::mt19937_64 rng(34);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3> pts(2000);
+  for (Vec3& p : pts) p = {u(rng), u(rng), u(rng)};
+  const Counts c = CompareSizes(pts, true);
+  EXPECT_GT(c.shrunk, 0u);
+}
+
+TEST(OmegaMeshTest, ShrunkSizeOnALatticeWithTiedCorners) {
+  // A shuffled 9³ lattice: cospherical points everywhere, so farthest
+  // corners tie and circumcentres coincide.
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 9; ++i) {
+    for (int j = 0; j < 9; ++j) {
+      for (int k = 0; k < 9; ++k) pts.push_back({i / 8.0, j / 8.0, k / 8.0});
+    }
+  }
+  std::shuffle(pts.begin(), pts.end(), std::mt19937_64(56));
+  const Counts c = CompareSizes(pts, false);
+  EXPECT_GT(c.shrunk, 0u);
+}
+
+}  // namespace
+}  // namespace svrc::refine
