@@ -395,6 +395,7 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
   r.vertex = VertexId(v);
   r.destroyed = destroyed_;
   r.created = created_;
+  r.created_on = boundary_;
   r.cavity_vertices = cavity_vertices_;
   return r;
 }

@@ -77,6 +77,10 @@ class Delaunay3 {
     // generations. Both lists include ghost tets.
     std::span<const TetId> destroyed;
     std::span<const TetId> created;
+    // Per created tet (same index): 4·d + f, where d is the destroyed tet
+    // whose face f (on the cavity boundary) it was built on. Empty when the
+    // insertion made the first tets.
+    std::span<const uint32_t> created_on;
     // Finite vertices on the cavity boundary (whose Voronoi cells changed),
     // excluding `vertex`, each once, in a deterministic order.
     std::span<const VertexId> cavity_vertices;

@@ -453,6 +453,17 @@ class Refiner {
   // Balls that got a first, non-native encroacher (PartiallyEncroached).
   std::vector<BallId> partial_;
   std::vector<double> size_target_;  // per M_Ω vertex: max R_v from max_volume (+inf: none)
+  // Per M_Ω tet slot: the size target its region gives its vertices (+inf:
+  // none), from the last SetSizeTargets' labelling and carried to the tets
+  // of every cavity that lies in one such region (PropagateSizeTargets).
+  // Valid while gen == Generation + 1 (live) or == Generation (just freed).
+  struct TetTarget {
+    uint32_t gen = 0;
+    double target = HUGE_VAL;
+  };
+  std::vector<TetTarget> tet_target_;
+  void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
+  std::vector<TetTarget> created_target_;  // scratch
   // Collars (stage (d)).
   const plc::FeatureComplex* complex_ = nullptr;
   CollarIndex collars_;
@@ -1374,6 +1385,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   std::vector<VertexId> changed(result.cavity_vertices.begin(), result.cavity_vertices.end());
   changed.push_back(nv);
   for (VertexId u : changed) omega_.BumpCell(u);
+  if (!tet_target_.empty()) PropagateSizeTargets(result);
 
   // R_v, r_v of 𝒱' (Figure 3.5's loop), or a certificate that V(u) is
   // still good, without a star walk. cell_cert_[u] (set from u's last
@@ -1520,6 +1532,53 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // Figure 3.5 lines 5–7: a crease point from a lower feature gets its collar.
   if (options_.collars && points_.IsCrease(p) && points_.CdOf(p).dim < 3) return CreateCollar(p, nv);
   return absl::OkStatus();
+}
+
+// max_volume between size rounds: without it a vertex inserted after a
+// round's labelling has no target until the next round labels it, and the
+// rounds refine in waves (cube.poly --max-volume 1e-5: 6 labellings of the
+// whole M_Ω, each finding the previous round's new vertices). The mesh
+// conforms to the facets between insertions, so every tet lies in one
+// region, and a new tet lies on the same side of every facet as the
+// destroyed tet whose cavity-boundary face it was built on (it is that
+// face's cone from the new point, inside the cavity): it gets that tet's
+// region target, and its vertices the smallest target of their new tets
+// (SetSizeTargets' rule). A tet built on a tet without a label (a ghost, or
+// one built on such a tet since) gets none, and the next round labels it.
+// The rounds still end only when a labelling finds no vertex above its
+// target, so this changes how fast they converge, not what they guarantee.
+void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted) {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  const size_t n = inserted.created.size();
+  if (inserted.created_on.size() != n) return;
+  // Read every base before writing: the new tets reuse the cavity's slots.
+  created_target_.assign(n, TetTarget{});
+  for (size_t k = 0; k < n; ++k) {
+    const TetId d(inserted.created_on[k] >> 2);
+    // Freed once by this insertion: Generation moved one past its live value.
+    if (d.value() < tet_target_.size() && tet_target_[d.value()].gen != 0 &&
+        tet_target_[d.value()].gen == dt.Generation(d)) {
+      created_target_[k] = tet_target_[d.value()];
+    }
+  }
+  if (tet_target_.size() < dt.TetCapacity()) tet_target_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  if (size_target_.size() < dt.NumVertices()) size_target_.resize(dt.NumVertices() + dt.NumVertices() / 2 + 16, HUGE_VAL);
+  for (size_t k = 0; k < n; ++k) {
+    const TetId c = inserted.created[k];
+    const bool known = created_target_[k].gen != 0;
+    const double target = created_target_[k].target;
+    tet_target_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target};
+    if (!known || target == HUGE_VAL || dt.IsGhost(c)) continue;
+    for (int i = 0; i < 4; ++i) {
+      const uint32_t v = dt.TetVertex(c, i).value();
+      if (target < size_target_[v]) {
+        size_target_[v] = target;
+        // A certificate proved the old star within the old target only.
+        if (v < cell_cert_.size()) cell_cert_[v].valid = false;
+        ++stats_.size_targets_propagated;
+      }
+    }
+  }
 }
 
 absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd) {
@@ -2455,6 +2514,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   std::vector<Vec3> positions(nv);
   for (uint32_t v = 0; v < nv; ++v) positions[v] = dt.Point(VertexId(v));
   std::vector<std::array<uint32_t, 4>> tets;
+  std::vector<TetId> tet_ids;  // M_Ω's tets, when `tets` are they
   std::vector<ConstrainedFace> faces;
   if (stitched_done_) {
     // After RipStitchCollar (collars): label the stitched mesh, whose facets
@@ -2473,7 +2533,8 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       faces.push_back(cf);
     }
   } else {
-    for (TetId t : dt.FiniteTets()) {
+    tet_ids = dt.FiniteTets();
+    for (TetId t : tet_ids) {
       tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
                       dt.TetVertex(t, 3).value()});
     }
@@ -2510,7 +2571,11 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   if (size_target_.size() < nv) size_target_.resize(nv, HUGE_VAL);
   cell_cert_.clear();  // certificates read the size targets
   std::vector<uint8_t> touched(nv, 0);
+  // Per-tet targets for PropagateSizeTargets, on M_Ω's own tets only.
+  tet_target_.clear();
+  if (!tet_ids.empty() && options_.propagate_size_targets) tet_target_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
   for (size_t t = 0; t < tets.size(); ++t) {
+    if (!tet_target_.empty()) tet_target_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL};
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     double vmax = HUGE_VAL;
     const double region = lab->components[lab->tet_component[t]].max_volume;
@@ -2520,6 +2585,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     // Regular tet of volume V: edge a = (6√2·V)^(1/3), circumradius a·√6/4.
     const double a = std::cbrt(6.0 * std::sqrt(2.0) * vmax * scale3);
     const double rt = a * std::sqrt(6.0) / 4.0;
+    if (!tet_target_.empty()) tet_target_[tet_ids[t].value()].target = rt;
     for (uint32_t v : tets[t]) {
       if (rt < size_target_[v]) {
         size_target_[v] = rt;
@@ -2938,6 +3004,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.sizes_certified", static_cast<double>(sizes_certified));
   out->Set("svrc.sizes_uncertified", static_cast<double>(sizes_uncertified));
   out->Set("svrc.sizes_shrunk", static_cast<double>(sizes_shrunk));
+  out->Set("svrc.size_targets_propagated", static_cast<double>(size_targets_propagated));
   out->Set("svrc.destroys_local", static_cast<double>(destroys_local));
   out->Set("svrc.warps", static_cast<double>(warps));
   out->Set("svrc.yields", static_cast<double>(yields));

@@ -34,6 +34,10 @@ struct RefineOptions {
   // their memo (OmegaMesh::ShrunkSize). false: Size() for every cavity cell,
   // the reference both must reproduce bit for bit (tests).
   bool certify_cells = true;
+  // max_volume: a cavity lying in labelled regions of one size target gives
+  // it to its new point and cells, between the size rounds' labellings
+  // (refiner.cc, PropagateSizeTargets). false: only the rounds set targets.
+  bool propagate_size_targets = true;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
@@ -185,6 +189,7 @@ struct RefineStats {
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)
+  uint64_t size_targets_propagated = 0;  // max_volume targets given between size rounds
   uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)
   uint64_t predicate_calls = 0;
   uint64_t predicate_exact = 0;    // filter failures → exact arithmetic

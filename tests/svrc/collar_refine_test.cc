@@ -390,6 +390,49 @@ TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
   }
 }
 
+// RefineOptions::propagate_size_targets: max_volume targets carried from a
+// size round's labelling to the tets and points of later cavities. Without
+// it the rounds refine in waves, each labelling finding the last round's new
+// vertices without a target (cube.poly --max-volume 1e-5: 5 rounds, 6
+// labellings); with it one round settles. Every tet within its region's
+// bound is checked on the same inputs in PlcRefine.MaxVolumeGlobalAndPerRegion.
+TEST(CollarRefine, PropagatedSizeTargetsSettleInOneRound) {
+  struct Case {
+    const char* what;
+    plc::Plc plc;
+    double max_volume;
+  };
+  absl::StatusOr<plc::Plc> cube = plc::ReadPlcFile(testing::CorpusPath("a_convex/cube.poly"));
+  ASSERT_TRUE(cube.ok()) << cube.status();
+  absl::StatusOr<plc::Plc> facet = plc::ReadPlcFile(testing::CorpusPath("b_internal/box_internal_facet.poly"));
+  ASSERT_TRUE(facet.ok()) << facet.status();
+  const std::vector<Case> cases = {{"cube 1e-4", *cube, 1e-4},
+                                   {"box_internal_facet 1e-4", *facet, 1e-4},
+                                   {"nested boxes", plc::families::NestedBoxes(3, 1e-2, 1.0 / 8), 0}};
+  for (const Case& c : cases) {
+    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(c.plc);
+    ASSERT_TRUE(cx.ok()) << cx.status();
+    uint64_t rounds[2] = {0, 0}, insertions[2] = {0, 0};
+    for (int on = 0; on < 2; ++on) {
+      RefineOptions opt;
+      opt.max_volume = c.max_volume;
+      opt.propagate_size_targets = on == 1;
+      absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+      ASSERT_TRUE(run.ok()) << c.what << ": " << run.status();
+      rounds[on] = run->stats.size_rounds;
+      insertions[on] = run->stats.insertions;
+      EXPECT_EQ(run->stats.size_targets_propagated > 0, on == 1) << c.what;
+    }
+    EXPECT_GT(rounds[0], rounds[1]) << c.what;
+    EXPECT_LE(rounds[1], 1u) << c.what;
+    // A target carried across a facet into the exterior would refine Ω's
+    // exterior at the region's size: several times the points.
+    EXPECT_LE(insertions[1], insertions[0] * 11 / 10) << c.what;
+    std::printf("%s: size rounds %llu without, %llu with; insertions %llu, %llu\n", c.what, (unsigned long long)rounds[0],
+                (unsigned long long)rounds[1], (unsigned long long)insertions[0], (unsigned long long)insertions[1]);
+  }
+}
+
 // RefineOptions::reuse_round_work: the COLLAR rounds' per-ball restricted
 // Delaunay of S, the settled facets' arc checks and EnqueueMissing's memory
 // of simplices found in M_Ω must give the refinement of a run that
