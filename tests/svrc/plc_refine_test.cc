@@ -99,6 +99,25 @@ double Volume6(const mesh::TetMesh& m, size_t t) {
   return geom::Dot(m.positions[v[1]] - a, geom::Cross(m.positions[v[2]] - a, m.positions[v[3]] - a));
 }
 
+// A mild crease (example.poly: 63°, refined through without collars under a
+// vertex budget) with a max_volume that needs more vertices than the budget
+// of the input alone: until the budget counted max_volume (CreaseBudget in
+// core/api.cc) this ended FAILED_PRECONDITION "did not finish within 20112
+// vertices" (it needs ~38k in M_Ω).
+TEST(PlcRefine, MildCreaseWithMaxVolumeBeyondTheInputBudget) {
+  if (kSanitized) GTEST_SKIP() << "release only (~4 s)";
+  core::MeshParams params;
+  params.max_volume = 3e-4;
+  Meshed m = MeshCorpus("b_internal/example.poly", params);
+  ASSERT_FALSE(m.mesh.tets.empty());
+  const mesh::ConformityReport rep = mesh::CheckConformity(m.plc, m.mesh);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  EXPECT_GT(m.mesh.positions.size(), 20112u);
+  double worst = 0;
+  for (size_t t = 0; t < m.mesh.tets.size(); ++t) worst = std::max(worst, Volume6(m.mesh, t) / 6);
+  EXPECT_LE(worst, 3e-4);
+}
+
 // Every generated family without creases (core/plc/families.h): boxes with
 // internal facets, a hole, a cavity, a tunnel (facets with holes), an
 // internal facet with a polygonal hole, free segments and isolated points,
