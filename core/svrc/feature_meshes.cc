@@ -123,21 +123,32 @@ CellSize OmegaMesh::Size(VertexId v) const {
     if (m.clipped) ++stats_.clipped_queries;
     return m;
   }
-  bool unique = false;
+  Uniqueness unique;
   const CellSize out = ComputeSize(v, &unique);
   if (size_memo_.size() <= v.value()) size_memo_.resize(dt_.NumVertices() + dt_.NumVertices() / 2 + 16);
-  size_memo_[v.value()] = {key, out, out.hint.valid() ? dt_.Generation(out.hint) : 0, unique};
+  size_memo_[v.value()] = {key, out, out.hint.valid() ? dt_.Generation(out.hint) : 0,
+                           out.kept_hint.valid() ? dt_.Generation(out.kept_hint) : 0, unique};
   return out;
 }
 
-bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, uint32_t new_tets, double new_corner, CellSize* out) const {
+bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, uint32_t new_tets, double new_corner, double new_kept_corner,
+                           bool new_outside, CellSize* out) const {
   if (v.value() >= size_memo_.size()) return false;
   SizeMemo& m = size_memo_[v.value()];
   const uint32_t key = dt_.StarVersion(v) + 1;
-  if (m.key == 0 || m.key + new_tets != key || !m.unique || m.size.clipped || m.size.saw_flat) return false;
-  if (!(new_corner < m.size.outradius) || !m.size.hint.valid() || !dt_.IsAlive(m.size.hint) ||
-      dt_.Generation(m.size.hint) != m.hint_gen) {
-    return false;
+  if (m.key == 0 || m.key + new_tets != key || m.size.clipped || m.size.saw_flat) return false;
+  auto survived = [&](TetId t, uint32_t gen) { return t.valid() && dt_.IsAlive(t) && dt_.Generation(t) == gen; };
+  // The cell's farthest corner.
+  if (!m.unique.corner || !(new_corner < m.size.outradius) || !survived(m.size.hint, m.hint_gen)) return false;
+  if (m.size.outside_tets || new_outside) {
+    // The kept corner, over the tets not known to lie outside.
+    if (m.size.kept_outradius == 0) {
+      if (new_kept_corner != 0) return false;  // no kept tet before; one now
+    } else if (!m.unique.kept_corner || !(new_kept_corner < m.size.kept_outradius) ||
+               !survived(m.size.kept_hint, m.kept_hint_gen)) {
+      return false;
+    }
+    m.size.outside_tets = true;
   }
   ++stats_.size_queries;
   ++stats_.shrunk_sizes;
@@ -147,9 +158,9 @@ bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, uint32_t new_tets, double 
   return true;
 }
 
-CellSize OmegaMesh::ComputeSize(VertexId v, bool* unique) const {
+CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
   CellSize out;
-  *unique = false;
+  *unique = Uniqueness{};
   const Vec3& pv = dt_.Point(v);
   out.hint = dt_.VertexTet(v);
   // One star walk gives the star, the neighbours and, per neighbour, a tet on
@@ -160,7 +171,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v, bool* unique) const {
   for (VertexId w : sn.neighbors) shortest2 = std::min(shortest2, geom::Dist2(dt_.Point(w), pv));
   out.inradius = 0.5 * std::sqrt(shortest2);
   bool needs_clip = false;
-  double best = -1;
+  double best = -1, kept_best = -1;
   for (TetId t : sn.star) {
     if (dt_.IsGhost(t)) {
       needs_clip = true;
@@ -180,17 +191,67 @@ CellSize OmegaMesh::ComputeSize(VertexId v, bool* unique) const {
       best = d;
       out.corner = e.cc;
       out.hint = t;
-      *unique = true;
+      unique->corner = true;
     } else if (d == best) {
-      *unique = false;
+      unique->corner = false;
+    }
+    if (KnownOutside(t)) {
+      out.outside_tets = true;
+    } else if (d > kept_best) {
+      kept_best = d;
+      out.kept_corner = e.cc;
+      out.kept_hint = t;
+      unique->kept_corner = true;
+    } else if (d == kept_best) {
+      unique->kept_corner = false;
     }
   }
   if (!needs_clip) {
     out.outradius = best;
+    if (!out.outside_tets) {
+      out.kept_outradius = out.outradius;
+      out.kept_corner = out.corner;
+      out.kept_hint = out.hint;
+      unique->kept_corner = unique->corner;
+    } else if (kept_best < 0) {  // outside the output
+      out.kept_outradius = 0;
+      out.kept_corner = pv;
+      out.kept_hint = TetId();
+    } else {
+      out.kept_outradius = kept_best;
+    }
     return out;
   }
+  // Clipped (a star tet is a ghost or has its circumcentre outside Ω): the
+  // kept tets' corners, unless one of them is itself clipped.
+  out.outside_tets = false;
+  bool kept_plain = true;
+  kept_best = -1;
+  for (TetId t : sn.star) {
+    if (KnownOutside(t)) {
+      out.outside_tets = true;
+      continue;
+    }
+    if (dt_.IsGhost(t)) {
+      kept_plain = false;
+      continue;
+    }
+    const CcEntry& e = CachedCircumcenter(t);
+    if (e.flat) continue;
+    if (!e.inside) {
+      kept_plain = false;
+      continue;
+    }
+    const double d = geom::Dist(e.cc, pv);
+    if (d > kept_best) {
+      kept_best = d;
+      out.kept_corner = e.cc;
+      out.kept_hint = t;
+    }
+  }
+  const bool kept_from_star = out.outside_tets && kept_plain;
   // Clip every Voronoi facet of v (dual to edge vu) to the cube.
-  *unique = false;
+  *unique = Uniqueness{};
   ++stats_.clipped_queries;
   out.clipped = true;
   out.hint = dt_.VertexTet(v);
@@ -232,6 +293,17 @@ CellSize OmegaMesh::ComputeSize(VertexId v, bool* unique) const {
     }
   }
   out.outradius = best < 0 ? 0 : best;
+  if (!kept_from_star) {
+    out.kept_outradius = out.outradius;
+    out.kept_corner = out.corner;
+    out.kept_hint = out.hint;
+  } else if (kept_best < 0) {
+    out.kept_outradius = 0;
+    out.kept_corner = pv;
+    out.kept_hint = TetId();
+  } else {
+    out.kept_outradius = kept_best;
+  }
   return out;
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,25 @@ struct CellSize {
   TetId hint;
   bool clipped = false;   // the cell reached ∂Ω or infinity and was clipped
   bool saw_flat = false;  // a flat tet of the star was left out of R_v
+  // The same over the star's tets the last labelling keeps
+  // (OmegaMesh::SetLabels; docs/svrc-design.md §8 item 33): the circumcentres
+  // of the output's tets at v. Equal to the fields above while M_Ω is not
+  // labelled or no star tet is known to lie outside the output; 0 (and v)
+  // when every star tet does. The Skinny and size tests read these.
+  double kept_outradius = 0;
+  geom::Vec3 kept_corner;
+  TetId kept_hint;
+  bool outside_tets = false;  // a star tet is known to lie outside the output
+};
+
+// Per M_Ω tet slot: its region's size target (+inf: none) and whether the
+// output keeps it, from the refiner's last labelling and carried to new tets
+// (refiner.cc PropagateSizeTargets). Valid while gen == Generation + 1 (a
+// live tet) or gen == Generation (a tet just freed by an insertion).
+struct TetLabel {
+  uint32_t gen = 0;
+  double target = HUGE_VAL;
+  bool kept = false;
 };
 
 class OmegaMesh {
@@ -62,6 +82,19 @@ class OmegaMesh {
   // cube (Sutherland–Hodgman). Corners created on a cube face get that face's
   // coordinate exactly, so they lie on ∂Ω.
   CellSize Size(VertexId v) const;
+  // Tet labels for CellSize's kept_* fields (nullptr: none; every tet
+  // counts as kept). Drops every memo of Size().
+  void SetLabels(const std::vector<TetLabel>* labels) {
+    labels_ = labels;
+    size_memo_.clear();
+  }
+  // t (a ghost, or a finite tet with a valid label) lies outside the output.
+  bool KnownOutside(TetId t) const {
+    if (labels_ == nullptr) return false;
+    if (dt_.IsGhost(t)) return true;
+    return t.value() < labels_->size() && (*labels_)[t.value()].gen == dt_.Generation(t) + 1 &&
+           !(*labels_)[t.value()].kept;
+  }
   // Size(v) right after an insertion next to v, from v's memo of the star
   // before it, without a star walk: when the only change to v's star since
   // the memo is this insertion (`new_tets` new tets at v), the memo's cell
@@ -70,7 +103,13 @@ class OmegaMesh {
   // (`new_corner`, their largest). Then R_v, the corner and the hint stay
   // (V(v) only shrank) and r_v = min(r_v, |vp|/2) (Lemma 3) — the doubles
   // Size() would compute, so the verdicts do not change. False: call Size().
-  bool ShrunkSize(VertexId v, const geom::Vec3& p, uint32_t new_tets, double new_corner, CellSize* out) const;
+  // `new_kept_corner`: the same over the new tets not known to lie outside
+  // the output (SetLabels), `new_outside`: one of them does. With labels, a
+  // cell whose star had or gets such tets keeps its kept corner when that
+  // corner's tet survived likewise, and CellSize::outside_tets may then
+  // stay set after the last such tet went (it only ever costs a star walk).
+  bool ShrunkSize(VertexId v, const geom::Vec3& p, uint32_t new_tets, double new_corner, double new_kept_corner,
+                  bool new_outside, CellSize* out) const;
   // The circumcentre of finite tet t as Size() reads it for each vertex of t
   // (R_v is the largest |cc − v| over v's star); false when Size() would not
   // read it plainly: t flat, or its circumcentre outside Ω (clipped cells).
@@ -95,8 +134,14 @@ class OmegaMesh {
 
  private:
   bool InsideCube(const geom::Vec3& p) const;
-  // Size() without the memo; *unique: no other star tet is as far as the corner's.
-  CellSize ComputeSize(VertexId v, bool* unique) const;
+  // Whether no other star tet (no other kept star tet) is as far as the
+  // corner's (the kept corner's): ShrunkSize needs it.
+  struct Uniqueness {
+    bool corner = false;
+    bool kept_corner = false;
+  };
+  // Size() without the memo.
+  CellSize ComputeSize(VertexId v, Uniqueness* unique) const;
   // Appends the polygon clipped to the cube to `out` (vertices only).
   void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
   // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
@@ -133,10 +178,12 @@ class OmegaMesh {
   struct SizeMemo {
     uint32_t key = 0;  // StarVersion + 1 when computed; 0: none
     CellSize size;
-    uint32_t hint_gen = 0;  // Generation(size.hint) when computed
-    bool unique = false;    // ComputeSize's *unique
+    uint32_t hint_gen = 0;       // Generation(size.hint) when computed
+    uint32_t kept_hint_gen = 0;  // Generation(size.kept_hint) when computed
+    Uniqueness unique;
   };
   mutable std::vector<SizeMemo> size_memo_;
+  const std::vector<TetLabel>* labels_ = nullptr;
   // Scratch.
   mutable std::vector<geom::Vec3> poly_, poly2_;
 };

@@ -137,7 +137,9 @@ class Refiner {
   absl::Status Destroy(const WorkEvent& event);
   // A gap ball of M_Ω (Skinny₃ / Unresolved₃ of cell v): warp, else yield,
   // else insert the centre.
-  absl::Status DestroyOmega(VertexId v);
+  // skinny: a Skinny event's gap ball (the kept corners, CellSize::kept_*);
+  // else an Unresolved event's (the whole cell).
+  absl::Status DestroyOmega(VertexId v, bool skinny);
   // Figure 3.4 for the gap ball B(c, r) of M_Ω, c in the cell of v.
   absl::Status DestroyOmegaAt(const Vec3& c, double r, TetId hint, VertexId v, Cd cd_ball = kCdSpace);
  public:
@@ -387,10 +389,12 @@ class Refiner {
   void RefreshSegmentEvents(uint32_t seg, uint32_t v);
   void RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size = nullptr);
   bool IsLive(const WorkEvent& event);
-  bool IsSkinny(const CellSize& s) const { return s.outradius > options_.tau * s.inradius; }
+  // On the corners of the output's tets at v once M_Ω is labelled
+  // (CellSize::kept_outradius; docs/svrc-design.md §8 item 33).
+  bool IsSkinny(const CellSize& s) const { return s.kept_outradius > options_.tau * s.inradius; }
   // Skinny, or larger than the size target of max_volume (SetSizeTargets).
   bool IsBad(VertexId v, const CellSize& s) const {
-    return IsSkinny(s) || (v.value() < size_target_.size() && s.outradius > size_target_[v.value()]);
+    return IsSkinny(s) || (v.value() < size_target_.size() && s.kept_outradius > size_target_[v.value()]);
   }
   bool IsSkinny(const SegmentMesh::Size1& s) const { return s.outradius > options_.tau * s.inradius; }
   // Facet meshes: Voronoi aspect bound facet_tau_factor·τ (RefineOptions).
@@ -457,10 +461,7 @@ class Refiner {
   // none), from the last SetSizeTargets' labelling and carried to the tets
   // of every cavity that lies in one such region (PropagateSizeTargets).
   // Valid while gen == Generation + 1 (live) or == Generation (just freed).
-  struct TetTarget {
-    uint32_t gen = 0;
-    double target = HUGE_VAL;
-  };
+  using TetTarget = TetLabel;
   std::vector<TetTarget> tet_target_;
   void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
   std::vector<TetTarget> created_target_;  // scratch
@@ -561,11 +562,14 @@ class Refiner {
     double inradius = 0;   // r_v now
     double outradius = 0;  // R_v at the last Size(): ≥ R_v now
     bool valid = false;
+    bool exterior = false;  // every star tet outside the output at the last Size() (§8 item 33)
   };
   std::vector<CellCert> cell_cert_;
   std::vector<TetId> created_;
   std::vector<double> new_corner_;
   std::vector<uint32_t> new_tets_;  // new tets at each cell of 𝒱 (ShrunkSize)
+  std::vector<uint8_t> new_outside_, new_all_outside_;
+  std::vector<double> new_kept_corner_;
   std::vector<uint32_t> cert_mark_, cert_pos_;
   uint32_t cert_stamp_ = 0;
   std::vector<uint8_t> drop_;          // UpdateLocation: links of a shrunk cell to remove
@@ -953,9 +957,9 @@ void Refiner::RefreshEvents(VertexId v, const CellSize* size) {
   EventHandle& k = omega_.SkinnyEvent(v);
   if (IsBad(v, s)) {
     if (queues_.IsQueued(k)) {
-      queues_.Refresh(k, gen, s.corner, s.outradius);
+      queues_.Refresh(k, gen, s.kept_corner, s.kept_outradius);
     } else {
-      k = queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, v.value(), gen, s.outradius, s.corner});
+      k = queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, v.value(), gen, s.kept_outradius, s.kept_corner});
     }
   } else if (queues_.IsQueued(k)) {
     queues_.Remove(k);
@@ -1103,7 +1107,7 @@ absl::Status Refiner::Destroy(const WorkEvent& event) {
     const uint32_t seg = SegIndex(event.mesh);
     return DestroySegmentPiece(seg, segs_[seg].Size(event.object).piece);
   }
-  return DestroyOmega(VertexId(event.object));
+  return DestroyOmega(VertexId(event.object), event.type == EventType::kSkinny);
 }
 
 absl::Status Refiner::DestroyBall(BallId b) {
@@ -1247,11 +1251,12 @@ absl::Status Refiner::DestroySegmentPiece(uint32_t seg, uint32_t u) {
   return ForceInsertSegment(seg, u, t);
 }
 
-absl::Status Refiner::DestroyOmega(VertexId v) {
+absl::Status Refiner::DestroyOmega(VertexId v, bool skinny) {
   // Line 1 (stale test) was done at Dequeue. The gap ball is rebuilt from the
   // cell: ⟨(farthest corner of V(v) ∩ Ω, R_v), Ω⟩; CD(B) = CD(c) = (3,3).
   const CellSize s = (last_size_vertex_ == v && last_size_gen_ == omega_.CellGeneration(v)) ? last_size_
                                                                                            : omega_.Size(v);
+  if (skinny) return DestroyOmegaAt(s.kept_corner, s.kept_outradius, s.kept_hint, v);
   return DestroyOmegaAt(s.corner, s.outradius, s.hint, v);
 }
 
@@ -1418,15 +1423,25 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // one of them is a ghost, flat, or has its circumcentre outside Ω).
   new_corner_.assign(changed.size(), 0.0);
   new_tets_.assign(changed.size(), 0);
+  // Whether some / every new tet at u lies outside the output (labelled M_Ω,
+  // §8 item 33): one voids u's certificate and memo, all keep u outside.
+  new_outside_.assign(changed.size(), 0);
+  new_all_outside_.assign(changed.size(), 1);
+  new_kept_corner_.assign(changed.size(), 0.0);
   for (TetId t : created_) {
     Vec3 cc;
     const bool plain = !dt.IsGhost(t) && omega_.PlainCorner(t, &cc);
+    const bool outside = omega_.KnownOutside(t);
     for (int k = 0; k < 4; ++k) {
       const VertexId u = dt.TetVertex(t, k);
       if (u == nv || !u.valid() || u.value() >= nvert || cert_mark_[u.value()] != cert_stamp_) continue;
-      ++new_tets_[cert_pos_[u.value()]];
-      double& m = new_corner_[cert_pos_[u.value()]];
+      const uint32_t i = cert_pos_[u.value()];
+      ++new_tets_[i];
+      double& m = new_corner_[i];
       m = plain ? std::max(m, geom::Dist(cc, dt.Point(u))) : HUGE_VAL;
+      new_outside_[i] |= outside ? 1 : 0;
+      new_all_outside_[i] &= outside ? 1 : 0;
+      if (!outside) new_kept_corner_[i] = plain ? std::max(new_kept_corner_[i], geom::Dist(cc, dt.Point(u))) : HUGE_VAL;
     }
   }
   std::vector<CellSize> sizes(changed.size());
@@ -1435,7 +1450,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     const VertexId u = changed[i];
     exact[i] = 1;
     cell_cert_[u.value()] = {sizes[i].inradius, sizes[i].outradius,
-                             !sizes[i].clipped && !sizes[i].saw_flat && !IsBad(u, sizes[i])};
+                             !sizes[i].clipped && !sizes[i].saw_flat && !sizes[i].outside_tets && !IsBad(u, sizes[i]),
+                             sizes[i].outside_tets && sizes[i].kept_outradius == 0};
   };
   auto exact_size = [&](size_t i) {
     sizes[i] = omega_.Size(changed[i]);
@@ -1446,12 +1462,24 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     if (i + 1 < changed.size() && options_.certify_cells) {
       // Exact without a star walk when u's farthest corner survived (this
       // also keeps u's memo current for the next insertion next to it).
-      if (omega_.ShrunkSize(u, pos, new_tets_[i], new_corner_[i], &sizes[i])) {
+      if (omega_.ShrunkSize(u, pos, new_tets_[i], new_corner_[i], new_kept_corner_[i], new_outside_[i] != 0,
+                            &sizes[i])) {
         set_size(i);
         continue;
       }
       CellCert& cert = cell_cert_[u.value()];
-      if (cert.valid) {
+      // A cell outside the output stays outside while its new tets are: it
+      // is never bad (IsBad reads the kept corners), and its links read R_u
+      // through the bounds (its last R_u ≥ R_u now). Sizing it exactly would
+      // clip its Voronoi cell, and the cells next to ∂Ω have hundreds of
+      // neighbours (cube 1e-5: degree up to 1261; 40% of the CPU).
+      if (cert.exterior && new_all_outside_[i]) {
+        cert.inradius = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
+        exact[i] = 0;
+        ++stats_.sizes_outside;
+        continue;
+      }
+      if (cert.valid && !new_outside_[i]) {
         const double r = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
         const double m = new_corner_[i];
         const bool target = u.value() < size_target_.size();
@@ -1490,6 +1518,9 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
         // Certified cell: new_corner_[i] ≤ R_u ≤ cell_cert_[u].outradius.
         if (d <= (balls_.Radius(b) + new_corner_[i]) * (1 + 1e-9)) return true;
         if (!(d <= (balls_.Radius(b) + cell_cert_[u.value()].outradius) * (1 + 1e-9))) return false;
+        // Outside the output: keep the link (location may be inflated,
+        // guide §3) rather than clip the cell.
+        if (cell_cert_[u.value()].exterior) return true;
         exact_size(i);
         ++stats_.sizes_uncertified;
       }
@@ -1567,7 +1598,7 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
     const TetId c = inserted.created[k];
     const bool known = created_target_[k].gen != 0;
     const double target = created_target_[k].target;
-    tet_target_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target};
+    tet_target_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target, created_target_[k].kept};
     if (!known || target == HUGE_VAL || dt.IsGhost(c)) continue;
     for (int i = 0; i < 4; ++i) {
       const uint32_t v = dt.TetVertex(c, i).value();
@@ -2456,13 +2487,13 @@ absl::Status Refiner::CheckInvariants(bool final) {
     const VertexId v(w);
     const CellSize cs = omega_.Size(v);
     if (!IsBad(v, cs)) continue;
-    if (final && dt.Point(dt.NearestVertex(cs.corner, cs.hint)) != cs.corner) {
+    if (final && dt.Point(dt.NearestVertex(cs.kept_corner, cs.kept_hint)) != cs.kept_corner) {
       return absl::InternalError(absl::StrCat("SVRC invariant: cell ", w, " skinny at the end: R/r = ",
                                               cs.outradius / cs.inradius));
     }
     const EventHandle h = omega_.SkinnyEvent(v);
-    const VertexId near = dt.NearestVertex(cs.corner, cs.hint);
-    if (dt.Point(near) == cs.corner) continue;  // a phantom corner (DestroyOmega skips it)
+    const VertexId near = dt.NearestVertex(cs.kept_corner, cs.kept_hint);
+    if (dt.Point(near) == cs.kept_corner) continue;  // a phantom corner (DestroyOmega skips it)
     if (!queues_.IsQueued(h) || queues_.Get(h).generation != omega_.CellGeneration(v)) {
       return absl::InternalError(absl::StrCat("SVRC invariant: skinny cell ", w, " has no live Skinny event; corner (",
                                               cs.corner.x, ", ", cs.corner.y, ", ", cs.corner.z, ") R=", cs.outradius,
@@ -2574,8 +2605,13 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // Per-tet targets for PropagateSizeTargets, on M_Ω's own tets only.
   tet_target_.clear();
   if (!tet_ids.empty() && options_.propagate_size_targets) tet_target_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  // Cells are sized on the output's tets from now on (item 33); the memos
+  // of Size() drop.
+  omega_.SetLabels(!tet_target_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_target_ : nullptr);
   for (size_t t = 0; t < tets.size(); ++t) {
-    if (!tet_target_.empty()) tet_target_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL};
+    if (!tet_target_.empty()) {
+      tet_target_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL, lab->Kept(static_cast<uint32_t>(t))};
+    }
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     double vmax = HUGE_VAL;
     const double region = lab->components[lab->tet_component[t]].max_volume;
@@ -2980,7 +3016,7 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     dt.Neighbors(VertexId(w), &nbrs);
     st.max_degree = std::max<uint32_t>(st.max_degree, static_cast<uint32_t>(nbrs.size()));
     const CellSize cs = omega_.Size(VertexId(w));
-    if (cs.inradius > 0) st.max_aspect = std::max(st.max_aspect, cs.outradius / cs.inradius);
+    if (cs.inradius > 0) st.max_aspect = std::max(st.max_aspect, cs.kept_outradius / cs.inradius);
   }
   out.stats = st;
   return out;
@@ -3005,6 +3041,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.sizes_uncertified", static_cast<double>(sizes_uncertified));
   out->Set("svrc.sizes_shrunk", static_cast<double>(sizes_shrunk));
   out->Set("svrc.size_targets_propagated", static_cast<double>(size_targets_propagated));
+  out->Set("svrc.sizes_outside", static_cast<double>(sizes_outside));
   out->Set("svrc.destroys_local", static_cast<double>(destroys_local));
   out->Set("svrc.warps", static_cast<double>(warps));
   out->Set("svrc.yields", static_cast<double>(yields));

@@ -38,6 +38,12 @@ struct RefineOptions {
   // it to its new point and cells, between the size rounds' labellings
   // (refiner.cc, PropagateSizeTargets). false: only the rounds set targets.
   bool propagate_size_targets = true;
+  // Once the first size round has labelled M_Ω, the Skinny and size tests
+  // read only the corners of the tets the output keeps (CellSize::kept_*):
+  // Ω's exterior and holes are no longer graded for quality (the links and
+  // Unresolved events still read whole cells). docs/svrc-design.md §8 item
+  // 33. Needs propagate_size_targets; never with keep_bounding_box.
+  bool size_kept_tets = true;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
@@ -190,6 +196,7 @@ struct RefineStats {
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)
   uint64_t size_targets_propagated = 0;  // max_volume targets given between size rounds
+  uint64_t sizes_outside = 0;            // cavity cells outside the output, not sized (size_kept_tets)
   uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)
   uint64_t predicate_calls = 0;
   uint64_t predicate_exact = 0;    // filter failures → exact arithmetic

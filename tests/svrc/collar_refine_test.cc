@@ -394,8 +394,10 @@ TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
 // size round's labelling to the tets and points of later cavities. Without
 // it the rounds refine in waves, each labelling finding the last round's new
 // vertices without a target (cube.poly --max-volume 1e-5: 5 rounds, 6
-// labellings); with it one round settles. Every tet within its region's
-// bound is checked on the same inputs in PlcRefine.MaxVolumeGlobalAndPerRegion.
+// labellings); with it one round settles. RefineOptions::size_kept_tets
+// then sizes cells on the output's tets only (docs/svrc-design.md §8 item
+// 33). Every tet within its region's bound and the radius-edge bound with
+// both on are checked end to end in PlcRefine.MaxVolumeGlobalAndPerRegion.
 TEST(CollarRefine, PropagatedSizeTargetsSettleInOneRound) {
   struct Case {
     const char* what;
@@ -412,24 +414,35 @@ TEST(CollarRefine, PropagatedSizeTargetsSettleInOneRound) {
   for (const Case& c : cases) {
     absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(c.plc);
     ASSERT_TRUE(cx.ok()) << cx.status();
-    uint64_t rounds[2] = {0, 0}, insertions[2] = {0, 0};
-    for (int on = 0; on < 2; ++on) {
+    // Runs: 0 neither switch, 1 propagation only, 2 propagation and cells
+    // sized on the output's tets (size_kept_tets, the default).
+    uint64_t rounds[3] = {0, 0, 0}, insertions[3] = {0, 0, 0}, outside[3] = {0, 0, 0};
+    for (int run_i = 0; run_i < 3; ++run_i) {
       RefineOptions opt;
       opt.max_volume = c.max_volume;
-      opt.propagate_size_targets = on == 1;
+      opt.propagate_size_targets = run_i >= 1;
+      opt.size_kept_tets = run_i == 2;
       absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
       ASSERT_TRUE(run.ok()) << c.what << ": " << run.status();
-      rounds[on] = run->stats.size_rounds;
-      insertions[on] = run->stats.insertions;
-      EXPECT_EQ(run->stats.size_targets_propagated > 0, on == 1) << c.what;
+      rounds[run_i] = run->stats.size_rounds;
+      insertions[run_i] = run->stats.insertions;
+      outside[run_i] = run->stats.sizes_outside;
+      EXPECT_EQ(run->stats.size_targets_propagated > 0, run_i >= 1) << c.what;
     }
     EXPECT_GT(rounds[0], rounds[1]) << c.what;
     EXPECT_LE(rounds[1], 1u) << c.what;
+    EXPECT_LE(rounds[2], 1u) << c.what;
     // A target carried across a facet into the exterior would refine Ω's
     // exterior at the region's size: several times the points.
     EXPECT_LE(insertions[1], insertions[0] * 11 / 10) << c.what;
-    std::printf("%s: size rounds %llu without, %llu with; insertions %llu, %llu\n", c.what, (unsigned long long)rounds[0],
-                (unsigned long long)rounds[1], (unsigned long long)insertions[0], (unsigned long long)insertions[1]);
+    // Ω's exterior no longer graded: 13% (nested boxes) to 43% (cube 1e-4)
+    // fewer points.
+    EXPECT_EQ(outside[1], 0u) << c.what;
+    EXPECT_GT(outside[2], 0u) << c.what;
+    EXPECT_LT(insertions[2], insertions[1] * 9 / 10) << c.what;
+    std::printf("%s: size rounds %llu / %llu / %llu; insertions %llu / %llu / %llu\n", c.what,
+                (unsigned long long)rounds[0], (unsigned long long)rounds[1], (unsigned long long)rounds[2],
+                (unsigned long long)insertions[0], (unsigned long long)insertions[1], (unsigned long long)insertions[2]);
   }
 }
 

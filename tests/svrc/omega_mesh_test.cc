@@ -20,14 +20,23 @@ bool SameBits(double a, double b) { return std::bit_cast<uint64_t>(a) == std::bi
 struct Counts {
   size_t shrunk = 0;
   size_t cavity_cells = 0;
+  size_t shrunk_outside = 0;  // ... of cells with tets outside (labelled)
 };
 
 // Inserts `pts` into two copies of M_Ω. In `a`, every cavity cell is sized
 // by ShrunkSize when it answers (Size() otherwise, which keeps its memo
 // current, as ForceInsertOmega does); in `b`, always by Size() on a star it
 // has never seen. Every answer of `a` must equal `b`'s.
-Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third) {
+// With `labelled`, every tet gets a label when it is made (kept: its
+// centroid has x > 0.45; both meshes make the same tets in the same slots),
+// and the kept_* fields are compared too.
+Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool labelled = false) {
   OmegaMesh a(Vec3{0.5, 0.5, 0.5}, 2.0), b(Vec3{0.5, 0.5, 0.5}, 2.0);
+  std::vector<TetLabel> labels;
+  if (labelled) {
+    a.SetLabels(&labels);
+    b.SetLabels(&labels);
+  }
   std::array<PointId, 8> corners;
   for (uint32_t i = 0; i < 8; ++i) corners[i] = PointId(i);
   a.SeedCorners(corners);
@@ -41,9 +50,21 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third) {
     EXPECT_EQ(ra.vertex, rb.vertex);
     a.AddVertex(ra.vertex, id);
     b.AddVertex(rb.vertex, id);
+    if (labelled) {
+      for (size_t k = 0; k < ra.created.size(); ++k) {
+        const delaunay::TetId t = ra.created[k];
+        EXPECT_EQ(t, rb.created[k]);
+        if (labels.size() <= t.value()) labels.resize(t.value() + 1024);
+        if (a.dt().IsGhost(t)) continue;
+        double x = 0;
+        for (int i = 0; i < 4; ++i) x += a.dt().Point(a.dt().TetVertex(t, i)).x / 4;
+        labels[t.value()] = {a.dt().Generation(t) + 1, HUGE_VAL, x > 0.45};
+      }
+    }
     const std::vector<VertexId> cav(ra.cavity_vertices.begin(), ra.cavity_vertices.end());
     std::vector<uint32_t> new_tets(cav.size(), 0);
-    std::vector<double> corner(cav.size(), 0.0);
+    std::vector<double> corner(cav.size(), 0.0), kept_corner(cav.size(), 0.0);
+    std::vector<uint8_t> outside(cav.size(), 0);
     for (size_t i = 0; i < cav.size(); ++i) pos[cav[i].value()] = static_cast<uint32_t>(i);
     for (delaunay::TetId t : ra.created) {
       Vec3 cc;
@@ -54,6 +75,11 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third) {
         const uint32_t i = pos[u.value()];
         ++new_tets[i];
         corner[i] = plain ? std::max(corner[i], geom::Dist(cc, a.dt().Point(u))) : HUGE_VAL;
+        if (a.KnownOutside(t)) {
+          outside[i] = 1;
+        } else {
+          kept_corner[i] = plain ? std::max(kept_corner[i], geom::Dist(cc, a.dt().Point(u))) : HUGE_VAL;
+        }
       }
     }
     for (size_t i = 0; i < cav.size(); ++i) {
@@ -64,7 +90,7 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third) {
       // must notice the star changes it did not see.
       if (skip_every_third && (n + i) % 3 == 0) continue;
       CellSize sa;
-      const bool shrunk = a.ShrunkSize(u, pts[n], new_tets[i], corner[i], &sa);
+      const bool shrunk = a.ShrunkSize(u, pts[n], new_tets[i], corner[i], kept_corner[i], outside[i] != 0, &sa);
       if (shrunk) {
         ++out.shrunk;
       } else {
@@ -77,6 +103,12 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third) {
       EXPECT_EQ(sa.hint, sb.hint);
       EXPECT_EQ(sa.clipped, sb.clipped);
       EXPECT_EQ(sa.saw_flat, sb.saw_flat);
+      EXPECT_TRUE(SameBits(sa.kept_outradius, sb.kept_outradius)) << "vertex " << u.value() << " after point " << n;
+      for (int k = 0; k < 3; ++k) EXPECT_TRUE(SameBits(sa.kept_corner[k], sb.kept_corner[k]));
+      EXPECT_EQ(sa.kept_hint, sb.kept_hint);
+      // ShrunkSize may keep the flag after the last outside tet went.
+      EXPECT_GE(sa.outside_tets, sb.outside_tets);
+      if (shrunk && sb.outside_tets) ++out.shrunk_outside;
       if (testing::Test::HasFailure()) return out;
     }
     a.Size(ra.vertex);
@@ -94,6 +126,15 @@ TEST(OmegaMeshTest, ShrunkSizeEqualsSizeOnRandomPoints) {
   // Most cavity cells keep their farthest corner: the shortcut must answer
   // often, or the refiner gains nothing.
   EXPECT_GT(c.shrunk, c.cavity_cells / 5) << c.shrunk << " of " << c.cavity_cells;
+}
+
+TEST(OmegaMeshTest, ShrunkSizeOfLabelledCells) {
+  std::mt19937_64 rng(78);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3> pts(3000);
+  for (Vec3& p : pts) p = {u(rng), u(rng), u(rng)};
+  const Counts c = CompareSizes(pts, false, /*labelled=*/true);
+  EXPECT_GT(c.shrunk_outside, 100u) << c.shrunk << " of " << c.cavity_cells;
 }
 
 TEST(OmegaMeshTest, ShrunkSizeNoticesStaleMemos) {
