@@ -158,6 +158,23 @@ bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, uint32_t new_tets, double 
   return true;
 }
 
+// The kept_* fields once the whole cell is measured: the cell's own unless
+// they came from the kept tets (`from_kept`, their corner already set), and
+// none (0, v) when no star tet is kept.
+void OmegaMesh::FinishKept(bool from_kept, double kept_best, const Vec3& pv, CellSize* out) {
+  if (!from_kept) {
+    out->kept_outradius = out->outradius;
+    out->kept_corner = out->corner;
+    out->kept_hint = out->hint;
+  } else if (kept_best < 0) {
+    out->kept_outradius = 0;
+    out->kept_corner = pv;
+    out->kept_hint = TetId();
+  } else {
+    out->kept_outradius = kept_best;
+  }
+}
+
 CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
   CellSize out;
   *unique = Uniqueness{};
@@ -208,18 +225,8 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
   }
   if (!needs_clip) {
     out.outradius = best;
-    if (!out.outside_tets) {
-      out.kept_outradius = out.outradius;
-      out.kept_corner = out.corner;
-      out.kept_hint = out.hint;
-      unique->kept_corner = unique->corner;
-    } else if (kept_best < 0) {  // outside the output
-      out.kept_outradius = 0;
-      out.kept_corner = pv;
-      out.kept_hint = TetId();
-    } else {
-      out.kept_outradius = kept_best;
-    }
+    if (!out.outside_tets) unique->kept_corner = unique->corner;
+    FinishKept(out.outside_tets, kept_best, pv, &out);
     return out;
   }
   // Clipped (a star tet is a ghost or has its circumcentre outside Ω): the
@@ -293,17 +300,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
     }
   }
   out.outradius = best < 0 ? 0 : best;
-  if (!kept_from_star) {
-    out.kept_outradius = out.outradius;
-    out.kept_corner = out.corner;
-    out.kept_hint = out.hint;
-  } else if (kept_best < 0) {
-    out.kept_outradius = 0;
-    out.kept_corner = pv;
-    out.kept_hint = TetId();
-  } else {
-    out.kept_outradius = kept_best;
-  }
+  FinishKept(kept_from_star, kept_best, pv, &out);
   return out;
 }
 

@@ -142,6 +142,7 @@ class OmegaMesh {
   };
   // Size() without the memo.
   CellSize ComputeSize(VertexId v, Uniqueness* unique) const;
+  static void FinishKept(bool from_kept, double kept_best, const geom::Vec3& pv, CellSize* out);
   // Appends the polygon clipped to the cube to `out` (vertices only).
   void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
   // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
