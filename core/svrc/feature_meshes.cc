@@ -131,20 +131,19 @@ CellSize OmegaMesh::Size(VertexId v) const {
   return out;
 }
 
-bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, uint32_t new_tets, double new_corner, double new_kept_corner,
-                           bool new_outside, CellSize* out) const {
+bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, const NewTets& added, CellSize* out) const {
   if (v.value() >= size_memo_.size()) return false;
   SizeMemo& m = size_memo_[v.value()];
   const uint32_t key = dt_.StarVersion(v) + 1;
-  if (m.key == 0 || m.key + new_tets != key || m.size.clipped || m.size.saw_flat) return false;
+  if (m.key == 0 || m.key + added.count != key || m.size.clipped || m.size.saw_flat) return false;
   auto survived = [&](TetId t, uint32_t gen) { return t.valid() && dt_.IsAlive(t) && dt_.Generation(t) == gen; };
   // The cell's farthest corner.
-  if (!m.unique.corner || !(new_corner < m.size.outradius) || !survived(m.size.hint, m.hint_gen)) return false;
-  if (m.size.outside_tets || new_outside) {
+  if (!m.unique.corner || !(added.corner < m.size.outradius) || !survived(m.size.hint, m.hint_gen)) return false;
+  if (m.size.outside_tets || added.outside) {
     // The kept corner, over the tets not known to lie outside.
     if (m.size.kept_outradius == 0) {
-      if (new_kept_corner != 0) return false;  // no kept tet before; one now
-    } else if (!m.unique.kept_corner || !(new_kept_corner < m.size.kept_outradius) ||
+      if (added.kept_corner != 0) return false;  // no kept tet before; one now
+    } else if (!m.unique.kept_corner || !(added.kept_corner < m.size.kept_outradius) ||
                !survived(m.size.kept_hint, m.kept_hint_gen)) {
       return false;
     }

@@ -5,6 +5,7 @@
 // refreshes with DecreaseSize (Figure 3.5). The 1D/2D meshes come with stage (b)/(c).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -95,21 +96,37 @@ class OmegaMesh {
     return t.value() < labels_->size() && (*labels_)[t.value()].gen == dt_.Generation(t) + 1 &&
            !(*labels_)[t.value()].kept;
   }
+  // What an insertion added to one vertex's star: its new tets, the largest
+  // |cc − v| over them (+inf if one is a ghost, flat, or has its
+  // circumcentre outside Ω), the same over those not known to lie outside
+  // the output (SetLabels), and whether some / all of them do.
+  struct NewTets {
+    uint32_t count = 0;
+    double corner = 0;
+    double kept_corner = 0;
+    bool outside = false;
+    bool all_outside = true;
+    // One new tet at v: d = |cc − v|, or +inf when it is not plain.
+    void Add(double d, bool tet_outside) {
+      ++count;
+      corner = std::max(corner, d);
+      if (!tet_outside) kept_corner = std::max(kept_corner, d);
+      outside = outside || tet_outside;
+      all_outside = all_outside && tet_outside;
+    }
+  };
   // Size(v) right after an insertion next to v, from v's memo of the star
   // before it, without a star walk: when the only change to v's star since
-  // the memo is this insertion (`new_tets` new tets at v), the memo's cell
-  // was unclipped with no flat tet and a unique farthest corner whose tet
-  // survived, and every new tet at v is plain with |cc − v| < R_v
-  // (`new_corner`, their largest). Then R_v, the corner and the hint stay
-  // (V(v) only shrank) and r_v = min(r_v, |vp|/2) (Lemma 3) — the doubles
-  // Size() would compute, so the verdicts do not change. False: call Size().
-  // `new_kept_corner`: the same over the new tets not known to lie outside
-  // the output (SetLabels), `new_outside`: one of them does. With labels, a
-  // cell whose star had or gets such tets keeps its kept corner when that
-  // corner's tet survived likewise, and CellSize::outside_tets may then
-  // stay set after the last such tet went (it only ever costs a star walk).
-  bool ShrunkSize(VertexId v, const geom::Vec3& p, uint32_t new_tets, double new_corner, double new_kept_corner,
-                  bool new_outside, CellSize* out) const;
+  // the memo is this insertion (`added`), the memo's cell was unclipped with
+  // no flat tet and a unique farthest corner whose tet survived, and every
+  // new tet at v is plain with |cc − v| < R_v. Then R_v, the corner and the
+  // hint stay (V(v) only shrank) and r_v = min(r_v, |vp|/2) (Lemma 3) — the
+  // doubles Size() would compute, so the verdicts do not change. False: call
+  // Size(). With labels, a cell whose star had or gets tets outside the
+  // output keeps its kept corner when that corner's tet survived likewise,
+  // and CellSize::outside_tets may then stay set after the last such tet
+  // went (it only ever costs a star walk).
+  bool ShrunkSize(VertexId v, const geom::Vec3& p, const NewTets& added, CellSize* out) const;
   // The circumcentre of finite tet t as Size() reads it for each vertex of t
   // (R_v is the largest |cc − v| over v's star); false when Size() would not
   // read it plainly: t flat, or its circumcentre outside Ω (clipped cells).

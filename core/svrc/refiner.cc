@@ -457,14 +457,11 @@ class Refiner {
   // Balls that got a first, non-native encroacher (PartiallyEncroached).
   std::vector<BallId> partial_;
   std::vector<double> size_target_;  // per M_Ω vertex: max R_v from max_volume (+inf: none)
-  // Per M_Ω tet slot: the size target its region gives its vertices (+inf:
-  // none), from the last SetSizeTargets' labelling and carried to the tets
-  // of every cavity that lies in one such region (PropagateSizeTargets).
-  // Valid while gen == Generation + 1 (live) or == Generation (just freed).
-  using TetTarget = TetLabel;
-  std::vector<TetTarget> tet_target_;
+  // Per M_Ω tet slot (TetLabel): set by SetSizeTargets' labelling, carried
+  // to new tets by PropagateSizeTargets; empty while M_Ω is not labelled.
+  std::vector<TetLabel> tet_labels_;
   void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
-  std::vector<TetTarget> created_target_;  // scratch
+  std::vector<TetLabel> created_labels_;  // scratch
   // Collars (stage (d)).
   const plc::FeatureComplex* complex_ = nullptr;
   CollarIndex collars_;
@@ -566,10 +563,7 @@ class Refiner {
   };
   std::vector<CellCert> cell_cert_;
   std::vector<TetId> created_;
-  std::vector<double> new_corner_;
-  std::vector<uint32_t> new_tets_;  // new tets at each cell of 𝒱 (ShrunkSize)
-  std::vector<uint8_t> new_outside_, new_all_outside_;
-  std::vector<double> new_kept_corner_;
+  std::vector<OmegaMesh::NewTets> new_at_;  // per cell of 𝒱: what the insertion added to its star
   std::vector<uint32_t> cert_mark_, cert_pos_;
   uint32_t cert_stamp_ = 0;
   std::vector<uint8_t> drop_;          // UpdateLocation: links of a shrunk cell to remove
@@ -1390,7 +1384,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   std::vector<VertexId> changed(result.cavity_vertices.begin(), result.cavity_vertices.end());
   changed.push_back(nv);
   for (VertexId u : changed) omega_.BumpCell(u);
-  if (!tet_target_.empty()) PropagateSizeTargets(result);
+  if (!tet_labels_.empty()) PropagateSizeTargets(result);
 
   // R_v, r_v of 𝒱' (Figure 3.5's loop), or a certificate that V(u) is
   // still good, without a star walk. cell_cert_[u] (set from u's last
@@ -1419,15 +1413,11 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     cert_mark_[changed[i].value()] = cert_stamp_;
     cert_pos_[changed[i].value()] = static_cast<uint32_t>(i);
   }
-  // Largest |cc − u| over the new tets at each old cavity vertex u (+inf if
-  // one of them is a ghost, flat, or has its circumcentre outside Ω).
-  new_corner_.assign(changed.size(), 0.0);
-  new_tets_.assign(changed.size(), 0);
-  // Whether some / every new tet at u lies outside the output (labelled M_Ω,
-  // §8 item 33): one voids u's certificate and memo, all keep u outside.
-  new_outside_.assign(changed.size(), 0);
-  new_all_outside_.assign(changed.size(), 1);
-  new_kept_corner_.assign(changed.size(), 0.0);
+  // The new tets at each old cavity vertex u: their largest |cc − u| (+inf
+  // if one of them is a ghost, flat, or has its circumcentre outside Ω), and
+  // whether some / every one lies outside the output (labelled M_Ω, §8 item
+  // 33): one voids u's certificate and memo, all keep u outside.
+  new_at_.assign(changed.size(), OmegaMesh::NewTets{});
   for (TetId t : created_) {
     Vec3 cc;
     const bool plain = !dt.IsGhost(t) && omega_.PlainCorner(t, &cc);
@@ -1435,13 +1425,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     for (int k = 0; k < 4; ++k) {
       const VertexId u = dt.TetVertex(t, k);
       if (u == nv || !u.valid() || u.value() >= nvert || cert_mark_[u.value()] != cert_stamp_) continue;
-      const uint32_t i = cert_pos_[u.value()];
-      ++new_tets_[i];
-      double& m = new_corner_[i];
-      m = plain ? std::max(m, geom::Dist(cc, dt.Point(u))) : HUGE_VAL;
-      new_outside_[i] |= outside ? 1 : 0;
-      new_all_outside_[i] &= outside ? 1 : 0;
-      if (!outside) new_kept_corner_[i] = plain ? std::max(new_kept_corner_[i], geom::Dist(cc, dt.Point(u))) : HUGE_VAL;
+      new_at_[cert_pos_[u.value()]].Add(plain ? geom::Dist(cc, dt.Point(u)) : HUGE_VAL, outside);
     }
   }
   std::vector<CellSize> sizes(changed.size());
@@ -1462,26 +1446,25 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     if (i + 1 < changed.size() && options_.certify_cells) {
       // Exact without a star walk when u's farthest corner survived (this
       // also keeps u's memo current for the next insertion next to it).
-      if (omega_.ShrunkSize(u, pos, new_tets_[i], new_corner_[i], new_kept_corner_[i], new_outside_[i] != 0,
-                            &sizes[i])) {
+      if (omega_.ShrunkSize(u, pos, new_at_[i], &sizes[i])) {
         set_size(i);
         continue;
       }
       CellCert& cert = cell_cert_[u.value()];
+      const double r = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
       // A cell outside the output stays outside while its new tets are: it
       // is never bad (IsBad reads the kept corners), and its links read R_u
       // through the bounds (its last R_u ≥ R_u now). Sizing it exactly would
       // clip its Voronoi cell, and the cells next to ∂Ω have hundreds of
       // neighbours (cube 1e-5: degree up to 1261; 40% of the CPU).
-      if (cert.exterior && new_all_outside_[i]) {
-        cert.inradius = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
+      if (cert.exterior && new_at_[i].all_outside) {
+        cert.inradius = r;
         exact[i] = 0;
         ++stats_.sizes_outside;
         continue;
       }
-      if (cert.valid && !new_outside_[i]) {
-        const double r = std::min(cert.inradius, 0.5 * std::sqrt(geom::Dist2(dt.Point(u), pos)));
-        const double m = new_corner_[i];
+      if (cert.valid && !new_at_[i].outside) {
+        const double m = new_at_[i].corner;
         const bool target = u.value() < size_target_.size();
         if (!(m > options_.tau * r) && !(target && m > size_target_[u.value()]) &&
             (r == cert.inradius || !(cert.outradius > options_.tau * r))) {
@@ -1515,8 +1498,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     auto piece_meets = [&](BallId b) {
       const double d = geom::Dist(pu, balls_.Center(b));
       if (!exact[i]) {
-        // Certified cell: new_corner_[i] ≤ R_u ≤ cell_cert_[u].outradius.
-        if (d <= (balls_.Radius(b) + new_corner_[i]) * (1 + 1e-9)) return true;
+        // Certified cell: new_at_[i].corner ≤ R_u ≤ cell_cert_[u].outradius.
+        if (d <= (balls_.Radius(b) + new_at_[i].corner) * (1 + 1e-9)) return true;
         if (!(d <= (balls_.Radius(b) + cell_cert_[u.value()].outradius) * (1 + 1e-9))) return false;
         // Outside the output: keep the link (location may be inflated,
         // guide §3) rather than clip the cell.
@@ -1583,22 +1566,22 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
   const size_t n = inserted.created.size();
   if (inserted.created_on.size() != n) return;
   // Read every base before writing: the new tets reuse the cavity's slots.
-  created_target_.assign(n, TetTarget{});
+  created_labels_.assign(n, TetLabel{});
   for (size_t k = 0; k < n; ++k) {
     const TetId d(inserted.created_on[k] >> 2);
     // Freed once by this insertion: Generation moved one past its live value.
-    if (d.value() < tet_target_.size() && tet_target_[d.value()].gen != 0 &&
-        tet_target_[d.value()].gen == dt.Generation(d)) {
-      created_target_[k] = tet_target_[d.value()];
+    if (d.value() < tet_labels_.size() && tet_labels_[d.value()].gen != 0 &&
+        tet_labels_[d.value()].gen == dt.Generation(d)) {
+      created_labels_[k] = tet_labels_[d.value()];
     }
   }
-  if (tet_target_.size() < dt.TetCapacity()) tet_target_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  if (tet_labels_.size() < dt.TetCapacity()) tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
   if (size_target_.size() < dt.NumVertices()) size_target_.resize(dt.NumVertices() + dt.NumVertices() / 2 + 16, HUGE_VAL);
   for (size_t k = 0; k < n; ++k) {
     const TetId c = inserted.created[k];
-    const bool known = created_target_[k].gen != 0;
-    const double target = created_target_[k].target;
-    tet_target_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target, created_target_[k].kept};
+    const bool known = created_labels_[k].gen != 0;
+    const double target = created_labels_[k].target;
+    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target, created_labels_[k].kept};
     if (!known || target == HUGE_VAL || dt.IsGhost(c)) continue;
     for (int i = 0; i < 4; ++i) {
       const uint32_t v = dt.TetVertex(c, i).value();
@@ -2489,14 +2472,15 @@ absl::Status Refiner::CheckInvariants(bool final) {
     if (!IsBad(v, cs)) continue;
     if (final && dt.Point(dt.NearestVertex(cs.kept_corner, cs.kept_hint)) != cs.kept_corner) {
       return absl::InternalError(absl::StrCat("SVRC invariant: cell ", w, " skinny at the end: R/r = ",
-                                              cs.outradius / cs.inradius));
+                                              cs.kept_outradius / cs.inradius));
     }
     const EventHandle h = omega_.SkinnyEvent(v);
     const VertexId near = dt.NearestVertex(cs.kept_corner, cs.kept_hint);
     if (dt.Point(near) == cs.kept_corner) continue;  // a phantom corner (DestroyOmega skips it)
     if (!queues_.IsQueued(h) || queues_.Get(h).generation != omega_.CellGeneration(v)) {
       return absl::InternalError(absl::StrCat("SVRC invariant: skinny cell ", w, " has no live Skinny event; corner (",
-                                              cs.corner.x, ", ", cs.corner.y, ", ", cs.corner.z, ") R=", cs.outradius,
+                                              cs.kept_corner.x, ", ", cs.kept_corner.y, ", ", cs.kept_corner.z,
+                                              ") R=", cs.kept_outradius,
                                               " r=", cs.inradius, " clipped=", cs.clipped, " queued=", queues_.IsQueued(h) ? 1 : 0, " evgen=",
                                               queues_.IsQueued(h) ? queues_.Get(h).generation : 0, " cellgen=",
                                               omega_.CellGeneration(v)));
@@ -2603,14 +2587,14 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   cell_cert_.clear();  // certificates read the size targets
   std::vector<uint8_t> touched(nv, 0);
   // Per-tet targets for PropagateSizeTargets, on M_Ω's own tets only.
-  tet_target_.clear();
-  if (!tet_ids.empty() && options_.propagate_size_targets) tet_target_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  tet_labels_.clear();
+  if (!tet_ids.empty() && options_.propagate_size_targets) tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
   // Cells are sized on the output's tets from now on (item 33); the memos
   // of Size() drop.
-  omega_.SetLabels(!tet_target_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_target_ : nullptr);
+  omega_.SetLabels(!tet_labels_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_labels_ : nullptr);
   for (size_t t = 0; t < tets.size(); ++t) {
-    if (!tet_target_.empty()) {
-      tet_target_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL, lab->Kept(static_cast<uint32_t>(t))};
+    if (!tet_labels_.empty()) {
+      tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL, lab->Kept(static_cast<uint32_t>(t))};
     }
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     double vmax = HUGE_VAL;
@@ -2621,7 +2605,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     // Regular tet of volume V: edge a = (6√2·V)^(1/3), circumradius a·√6/4.
     const double a = std::cbrt(6.0 * std::sqrt(2.0) * vmax * scale3);
     const double rt = a * std::sqrt(6.0) / 4.0;
-    if (!tet_target_.empty()) tet_target_[tet_ids[t].value()].target = rt;
+    if (!tet_labels_.empty()) tet_labels_[tet_ids[t].value()].target = rt;
     for (uint32_t v : tets[t]) {
       if (rt < size_target_[v]) {
         size_target_[v] = rt;

@@ -62,9 +62,9 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
       }
     }
     const std::vector<VertexId> cav(ra.cavity_vertices.begin(), ra.cavity_vertices.end());
-    std::vector<uint32_t> new_tets(cav.size(), 0);
-    std::vector<double> corner(cav.size(), 0.0), kept_corner(cav.size(), 0.0);
-    std::vector<uint8_t> outside(cav.size(), 0);
+    // What the insertion added to each cavity vertex's star, as the refiner
+    // collects it (ForceInsertOmega).
+    std::vector<OmegaMesh::NewTets> added(cav.size());
     for (size_t i = 0; i < cav.size(); ++i) pos[cav[i].value()] = static_cast<uint32_t>(i);
     for (delaunay::TetId t : ra.created) {
       Vec3 cc;
@@ -72,14 +72,7 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
       for (int k = 0; k < 4; ++k) {
         const VertexId u = a.dt().TetVertex(t, k);
         if (u == ra.vertex || u.value() >= pos.size() || pos[u.value()] == UINT32_MAX) continue;
-        const uint32_t i = pos[u.value()];
-        ++new_tets[i];
-        corner[i] = plain ? std::max(corner[i], geom::Dist(cc, a.dt().Point(u))) : HUGE_VAL;
-        if (a.KnownOutside(t)) {
-          outside[i] = 1;
-        } else {
-          kept_corner[i] = plain ? std::max(kept_corner[i], geom::Dist(cc, a.dt().Point(u))) : HUGE_VAL;
-        }
+        added[pos[u.value()]].Add(plain ? geom::Dist(cc, a.dt().Point(u)) : HUGE_VAL, a.KnownOutside(t));
       }
     }
     for (size_t i = 0; i < cav.size(); ++i) {
@@ -90,7 +83,7 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
       // must notice the star changes it did not see.
       if (skip_every_third && (n + i) % 3 == 0) continue;
       CellSize sa;
-      const bool shrunk = a.ShrunkSize(u, pts[n], new_tets[i], corner[i], kept_corner[i], outside[i] != 0, &sa);
+      const bool shrunk = a.ShrunkSize(u, pts[n], added[i], &sa);
       if (shrunk) {
         ++out.shrunk;
       } else {
@@ -117,32 +110,29 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
   return out;
 }
 
-TEST(OmegaMeshTest, ShrunkSizeEqualsSizeOnRandomPoints) {
-  std::mt19937_64 rng(12);
+// n uniform random points in the unit cube.
+std::vector<Vec3> RandomPoints(uint64_t seed, size_t n) {
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Vec3> pts(3000);
+  std::vector<Vec3> pts(n);
   for (Vec3& p : pts) p = {u(rng), u(rng), u(rng)};
-  const Counts c = CompareSizes(pts, false);
+  return pts;
+}
+
+TEST(OmegaMeshTest, ShrunkSizeEqualsSizeOnRandomPoints) {
+  const Counts c = CompareSizes(RandomPoints(12, 3000), false);
   // Most cavity cells keep their farthest corner: the shortcut must answer
   // often, or the refiner gains nothing.
   EXPECT_GT(c.shrunk, c.cavity_cells / 5) << c.shrunk << " of " << c.cavity_cells;
 }
 
 TEST(OmegaMeshTest, ShrunkSizeOfLabelledCells) {
-  std::mt19937_64 rng(78);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Vec3> pts(3000);
-  for (Vec3& p : pts) p = {u(rng), u(rng), u(rng)};
-  const Counts c = CompareSizes(pts, false, /*labelled=*/true);
+  const Counts c = CompareSizes(RandomPoints(78, 3000), false, /*labelled=*/true);
   EXPECT_GT(c.shrunk_outside, 100u) << c.shrunk << " of " << c.cavity_cells;
 }
 
 TEST(OmegaMeshTest, ShrunkSizeNoticesStaleMemos) {
-  std::mt19937_64 rng(34);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Vec3> pts(2000);
-  for (Vec3& p : pts) p = {u(rng), u(rng), u(rng)};
-  const Counts c = CompareSizes(pts, true);
+  const Counts c = CompareSizes(RandomPoints(34, 2000), true);
   EXPECT_GT(c.shrunk, 0u);
 }
 
