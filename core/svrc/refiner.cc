@@ -119,8 +119,11 @@ class Refiner {
   // leaked targets across facets into the exterior: measured, the whole Ω
   // refined to max_volume); a τ-well-spaced neighbour of a small cell is small.
   // Enqueues the cells above target; returns whether any was.
-  absl::StatusOr<bool> SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume);
+  absl::StatusOr<bool> SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume,
+                                      bool all_vertices = false);
   void CountSizeRound() { ++stats_.size_rounds; }
+  bool skinny_deferred_ = false;
+  bool tet_mode_ = false;
  private:
   // End of the queues: a piece that is not an edge of M_Ω or of a facet mesh
   // containing it, or an in-facet triangle that is not a face of M_Ω, has a
@@ -391,7 +394,18 @@ class Refiner {
   bool IsLive(const WorkEvent& event);
   // On the corners of the output's tets at v once M_Ω is labelled
   // (CellSize::kept_outradius; docs/svrc-design.md §8 item 33).
-  bool IsSkinny(const CellSize& s) const { return s.kept_outradius > options_.tau * s.inradius; }
+  bool IsSkinny(const CellSize& s) const { return s.kept_outradius > CellTau() * s.inradius; }
+  // τ of the cell test: +inf while it is deferred or replaced by the per-tet
+  // test (RefineOptions::features_first, tet_quality).
+  double CellTau() const { return skinny_deferred_ || tet_mode_ ? HUGE_VAL : options_.tau; }
+  // tet_quality: whether t is an output tet of M_Ω's labelling that is bad
+  // (radius-edge above τ/2 or circumradius above its target); its
+  // circumcentre and radius.
+  bool TetBad(TetId t, Vec3* cc, double* radius) const;
+  // Enqueues t's Skinny event when TetBad; returns whether it did.
+  bool EnqueueTetIfBad(TetId t);
+  // WorkEvent::object of a per-tet Skinny event: the tet slot | kTetEvent.
+  static constexpr uint32_t kTetEvent = 1u << 31;
   // Skinny, or larger than the size target of max_volume (SetSizeTargets).
   bool IsBad(VertexId v, const CellSize& s) const {
     return IsSkinny(s) || (v.value() < size_target_.size() && s.kept_outradius > size_target_[v.value()]);
@@ -1028,6 +1042,11 @@ bool Refiner::IsLive(const WorkEvent& e) {
     SegmentMesh& m = segs_[SegIndex(e.mesh)];
     return m.CellGeneration(e.object) == e.generation && IsSkinny(m.Size(e.object));
   }
+  if (e.type == EventType::kSkinny && (e.object & kTetEvent) != 0) {
+    const delaunay::Delaunay3& dt = omega_.dt();
+    const TetId t(e.object & ~kTetEvent);
+    return t.value() < dt.TetCapacity() && dt.IsAlive(t) && dt.Generation(t) == e.generation;
+  }
   const VertexId v(e.object);
   if (omega_.CellGeneration(v) != e.generation) return false;
   if (e.type == EventType::kUnresolved) return blg_.NumUnresolved(kOmegaMesh, v.value()) > 0;
@@ -1100,6 +1119,10 @@ absl::Status Refiner::Destroy(const WorkEvent& event) {
   if (!IsOmega(event.mesh)) {
     const uint32_t seg = SegIndex(event.mesh);
     return DestroySegmentPiece(seg, segs_[seg].Size(event.object).piece);
+  }
+  if (event.type == EventType::kSkinny && (event.object & kTetEvent) != 0) {
+    const TetId t(event.object & ~kTetEvent);
+    return DestroyOmegaAt(event.center, event.radius, t, omega_.dt().TetVertex(t, 0));
   }
   return DestroyOmega(VertexId(event.object), event.type == EventType::kSkinny);
 }
@@ -1466,8 +1489,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
       if (cert.valid && !new_at_[i].outside) {
         const double m = new_at_[i].corner;
         const bool target = u.value() < size_target_.size();
-        if (!(m > options_.tau * r) && !(target && m > size_target_[u.value()]) &&
-            (r == cert.inradius || !(cert.outradius > options_.tau * r))) {
+        if (!(m > CellTau() * r) && !(target && m > size_target_[u.value()]) &&
+            (r == cert.inradius || !(cert.outradius > CellTau() * r))) {
           cert.inradius = r;
           exact[i] = 0;
           ++stats_.sizes_certified;
@@ -1543,9 +1566,38 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
       if (queues_.IsQueued(ke)) queues_.Remove(ke);
     }
   }
+  if (tet_mode_ && !skinny_deferred_ && !tet_labels_.empty()) {
+    for (TetId t : created_) EnqueueTetIfBad(t);
+  }
   // Figure 3.5 lines 5–7: a crease point from a lower feature gets its collar.
   if (options_.collars && points_.IsCrease(p) && points_.CdOf(p).dim < 3) return CreateCollar(p, nv);
   return absl::OkStatus();
+}
+
+bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  if (dt.IsGhost(t) || t.value() >= tet_labels_.size()) return false;
+  const TetLabel& lab = tet_labels_[t.value()];
+  if (lab.gen != dt.Generation(t) + 1 || !lab.kept) return false;
+  if (!omega_.PlainCorner(t, cc)) return false;
+  std::array<Vec3, 4> q;
+  for (int k = 0; k < 4; ++k) q[k] = dt.Point(dt.TetVertex(t, k));
+  const double r = geom::Dist(*cc, q[0]);
+  double l2 = HUGE_VAL;
+  for (int a = 0; a < 4; ++a) {
+    for (int b = a + 1; b < 4; ++b) l2 = std::min(l2, geom::Dist2(q[a], q[b]));
+  }
+  *radius = r;
+  const double rho = 0.5 * options_.tau;
+  return r * r > rho * rho * l2;
+}
+
+bool Refiner::EnqueueTetIfBad(TetId t) {
+  Vec3 cc;
+  double r = 0;
+  if (!TetBad(t, &cc, &r)) return false;
+  queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, t.value() | kTetEvent, omega_.dt().Generation(t), r, cc});
+  return true;
 }
 
 // max_volume between size rounds: without it a vertex inserted after a
@@ -2465,6 +2517,17 @@ absl::Status Refiner::CheckInvariants(bool final) {
                                               " but has no Unresolved event"));
     }
   }
+  // tet_quality: at the end no output tet is bad.
+  if (tet_mode_ && final) {
+    for (uint32_t i = 0; i < dt.TetCapacity(); ++i) {
+      const TetId t(i);
+      Vec3 cc;
+      double r = 0;
+      if (!dt.IsAlive(t) || !TetBad(t, &cc, &r)) continue;
+      if (dt.VertexAt(cc, t).valid()) continue;  // a phantom corner
+      return absl::InternalError(absl::StrCat("SVRC invariant: tet ", i, " bad at the end: R = ", r));
+    }
+  }
   // Every τ-skinny cell owns a live Skinny event; at the end there is none.
   for (uint32_t w = 0; w < dt.NumVertices(); ++w) {
     const VertexId v(w);
@@ -2523,7 +2586,8 @@ absl::Status Refiner::CheckInvariants(bool final) {
   return absl::OkStatus();
 }
 
-absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume) {
+absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume,
+                                             bool all_vertices) {
   const delaunay::Delaunay3& dt = omega_.dt();
   const uint32_t nv = dt.NumVertices();
   std::vector<Vec3> positions(nv);
@@ -2614,8 +2678,11 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     }
   }
   bool any = false;
+  if (tet_mode_) {
+    for (TetId t : tet_ids) any = EnqueueTetIfBad(t) || any;
+  }
   for (uint32_t v = 0; v < nv; ++v) {
-    if (!touched[v]) continue;
+    if (!touched[v] && !all_vertices) continue;
     const CellSize cs = omega_.Size(VertexId(v));
     if (IsBad(VertexId(v), cs)) {
       RefreshEvents(VertexId(v), &cs);
@@ -3195,8 +3262,24 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
     s = refiner.InsertCreaseVertices();
     if (!s.ok()) return s;
   }
+  const bool eligible = !options.collars && !options.keep_bounding_box && !complex.facets.empty() &&
+                        options.propagate_size_targets;
+  const bool tet_quality = eligible && options.tet_quality;
+  const bool features_first = eligible && (tet_quality || options.features_first);
+  if (features_first) refiner.skinny_deferred_ = true;
+  refiner.tet_mode_ = tet_quality;
   s = refiner.Run();
   if (!s.ok()) return s;
+  if (features_first) {
+    refiner.skinny_deferred_ = false;
+    absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume, /*all_vertices=*/true);
+    if (!more.ok()) return more.status();
+    bool volumes = options.max_volume > 0;
+    for (const plc::RegionSeed& sd : complex.regions) volumes = volumes || sd.max_volume > 0;
+    if (volumes) refiner.CountSizeRound();
+    s = refiner.Run();
+    if (!s.ok()) return s;
+  }
   // Size events (max_volume): label the conforming mesh, enqueue the cells
   // above their region's target, refine again; targets carry over to new
   // vertices, so a round converges and a few rounds settle region borders.

@@ -44,6 +44,16 @@ struct RefineOptions {
   // Unresolved events still read whole cells). docs/svrc-design.md §8 item
   // 33. Needs propagate_size_targets; never with keep_bounding_box.
   bool size_kept_tets = true;
+  // Experimental: M_Ω's Skinny test deferred until the features conform,
+  // then M_Ω labelled (as the size rounds do) and every cell tested on its
+  // kept tets only.
+  bool features_first = false;
+  // Experimental: once M_Ω is labelled, M_Ω's quality and size are tested
+  // per output tet (radius-edge > τ/2, circumradius > its region's target)
+  // instead of per Voronoi cell; a bad tet's circumball is the gap ball.
+  // Implies features_first. PLCs with facets, no collars, no
+  // keep_bounding_box only.
+  bool tet_quality = true;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
