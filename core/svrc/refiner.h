@@ -54,6 +54,11 @@ struct RefineOptions {
   // Implies features_first. PLCs with facets, no collars, no
   // keep_bounding_box only.
   bool tet_quality = true;
+  // With tet_quality, max_volume is tested per output tet (circumradius >
+  // the regular tet's of its region's bound) when the output's regions have
+  // different bounds, per cell (the same verdicts, fewer events) when they
+  // share one; true: per tet always.
+  bool tet_sizes = false;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
