@@ -88,6 +88,16 @@ Vec3 OmegaMesh::FarPoint(TetId g) const {
 }
 
 void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* scratch) const {
+  // Most Voronoi facets of a clipped cell lie inside Ω: each pass below
+  // would copy them unchanged (every vertex inside, in order), so skip them.
+  bool all_inside = true;
+  for (const Vec3& p : *poly) {
+    for (int k = 0; k < 3 && all_inside; ++k) {
+      all_inside = geom::Orient1d(cube_.lo[k], p[k]) >= 0 && geom::Orient1d(p[k], cube_.hi[k]) >= 0;
+    }
+    if (!all_inside) break;
+  }
+  if (all_inside) return;
   // Sutherland–Hodgman against lo_k <= x_k and x_k <= hi_k. Intersection
   // points get the plane's coordinate exactly, so corners on ∂Ω are on ∂Ω.
   for (int k = 0; k < 3 && !poly->empty(); ++k) {
