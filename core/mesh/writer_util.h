@@ -21,7 +21,7 @@ absl::Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::
 // shown as "-"), one line each, without comment markers.
 std::vector<std::string> ProvenanceLines(const Provenance& p);
 
-// %.17g: round-trips every double exactly.
+// The shortest decimal that round-trips (std::to_chars): every double exactly.
 void AppendDouble(std::string* out, double v);
 
 }  // namespace svrc::mesh::internal

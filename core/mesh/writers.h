@@ -1,5 +1,5 @@
 // Writers for the formats simulation codes read: TetGen .node/.ele/.face
-// (%.17g), VTK .vtu, Gmsh .msh 4.1, Medit .mesh. Each records the mesh's
+// (shortest round-trip decimals), VTK .vtu, Gmsh .msh 4.1, Medit .mesh. Each records the mesh's
 // provenance (svrc version, parameters, input sha256) in the format's comment
 // or metadata slot.
 #pragma once
