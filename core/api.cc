@@ -256,6 +256,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   // radius-edge <= params.radius_edge and (if any is set) max volumes; default target kDefaultSliverTargetDeg.
   refine::SliverOptions sliver;
   sliver.max_radius_edge = params.radius_edge;
+  // The labelling the refiner kept up: exterior tets are not worked on.
+  if (refined->tet_outside.size() == refined->tets.size()) sliver.skip_tet = refined->tet_outside;
   sliver.keep_max_volume = params.max_volume > 0 || std::any_of(plc.regions.begin(), plc.regions.end(),
                                                                  [](const plc::RegionSeed& r) { return r.max_volume > 0; });
   if (use_collars) {

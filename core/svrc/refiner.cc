@@ -3025,10 +3025,15 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   if (stitched_done_) {
     out.tets = stitched_;
   } else {
+    const bool labelled = !tet_labels_.empty();
     for (TetId t : dt.FiniteTets()) {
       std::array<uint32_t, 4> tet;
       for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
       out.tets.push_back(tet);
+      if (labelled) {
+        const bool known = t.value() < tet_labels_.size() && tet_labels_[t.value()].gen == dt.Generation(t) + 1;
+        out.tet_outside.push_back(known && !tet_labels_[t.value()].kept ? 1 : 0);
+      }
     }
   }
   std::vector<uint8_t> in_stitched;

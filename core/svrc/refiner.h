@@ -231,6 +231,10 @@ struct PointSetRefinement {
   // Tets of M_Ω over `positions`, positively oriented in normalised
   // coordinates (Delaunay3's invariant), in Delaunay3 slot order.
   std::vector<std::array<uint32_t, 4>> tets;
+  // Per tet of `tets` (empty unless M_Ω was labelled during the refinement
+  // and not stitched): 1 = known to lie outside the output (exterior or
+  // hole). SliverOptions::skip_tet.
+  std::vector<uint8_t> tet_outside;
   // Per input point: the position index of the mesh vertex it became (itself,
   // or an earlier point with identical coordinates).
   std::vector<uint32_t> input_vertex;

@@ -435,6 +435,8 @@ void FlipMesh::Undo(const Journal& journal) {
 }
 
 void FlipMesh::Push(uint32_t t) {
+  // An input tet outside the output (never replaced: version 0) is skipped.
+  if (t < options_.skip_tet.size() && options_.skip_tet[t] != 0 && version_[t] == 0) return;
   if (quality_[t].min_dihedral < options_.target_min_dihedral_deg) {
     queue_.emplace(quality_[t].min_dihedral, t, version_[t]);
   }

@@ -47,6 +47,11 @@ struct SliverOptions {
   // RipStitchCollar's stars made tets away from the creases of crease_pair 30°
   // reach radius-edge 7.8).
   std::vector<uint8_t> crease_vertex;
+  // One flag per input tet (empty: none): 1 = outside the output (the
+  // refiner's labelling, PointSetRefinement::tet_outside), never queued. A
+  // flip never crosses a constrained face, so the kept tets come out the
+  // same; only the time spent on ∂Ω's exterior goes.
+  std::vector<uint8_t> skip_tet;
   // No new tet may be larger (volume) than the largest input tet of its
   // component (the tets connected to it across non-constrained faces — the
   // labelling's components, docs/svrc-output.md §2). A flip never crosses a

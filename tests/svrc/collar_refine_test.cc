@@ -25,6 +25,7 @@
 #include "core/mesh/conformity.h"
 #include "core/mesh/quality.h"
 #include "core/svrc/assemble.h"
+#include "core/svrc/sliver.h"
 #include "gtest/gtest.h"
 #include "tests/test_support.h"
 
@@ -494,6 +495,54 @@ TEST(CollarRefine, TetQualityMeetsTheBoundWithFewerTets) {
     }
     EXPECT_LT(static_cast<double>(tets[1]), c.max_ratio * static_cast<double>(tets[0])) << c.file;
     std::printf("%s: %zu tets with the cell test, %zu with the per-tet test\n", c.file, tets[0], tets[1]);
+  }
+}
+
+// PointSetRefinement::tet_outside (the refiner's labels, kept up to the end
+// once M_Ω is labelled) lets the sliver pass skip ∂Ω's exterior
+// (SliverOptions::skip_tet). Flips never cross a constrained face, so the
+// output mesh must come out the same, bit for bit, with fewer candidates
+// (measured: cube 1e-4 12,737 → 3,611; instructions −4%, tiny_cube_in_box
+// −19%). A kept tet flagged outside would keep a sliver the full pass flips.
+TEST(CollarRefine, SliverPassSkipsTheExteriorWithTheSameOutput) {
+  struct Case {
+    const char* file;
+    double max_volume;
+  };
+  for (const Case& c : {Case{"e_spread/tiny_cube_in_box.poly", 0}, Case{"b_internal/box_in_box.poly", 1e-3}}) {
+    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.file));
+    ASSERT_TRUE(plc.ok()) << plc.status();
+    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+    ASSERT_TRUE(cx.ok()) << cx.status();
+    RefineOptions opt;
+    opt.max_volume = c.max_volume;
+    absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+    ASSERT_TRUE(run.ok()) << c.file << ": " << run.status();
+    ASSERT_EQ(run->tet_outside.size(), run->tets.size()) << c.file;
+    size_t outside = 0;
+    for (uint8_t o : run->tet_outside) outside += o;
+    EXPECT_GT(outside, 0u) << c.file;
+    const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
+    std::vector<mesh::TetMesh> meshes;
+    uint64_t candidates[2] = {0, 0};
+    for (int skip = 0; skip < 2; ++skip) {
+      SliverOptions so;
+      if (skip == 1) so.skip_tet = run->tet_outside;
+      absl::StatusOr<SliverResult> flipped =
+          RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so);
+      ASSERT_TRUE(flipped.ok()) << flipped.status();
+      candidates[skip] = flipped->stats.candidates;
+      absl::StatusOr<OutputStageResult> out = BuildOutputMesh(*plc, run->normalised_positions, flipped->tets,
+                                                              cx->point_of_vertex, faces, CoordinateMapOf(*run), false);
+      ASSERT_TRUE(out.ok()) << out.status();
+      meshes.push_back(std::move(out->mesh));
+    }
+    EXPECT_EQ(meshes[0].positions, meshes[1].positions) << c.file;
+    EXPECT_EQ(meshes[0].tets, meshes[1].tets) << c.file;
+    EXPECT_EQ(meshes[0].tet_region, meshes[1].tet_region) << c.file;
+    EXPECT_LT(candidates[1], candidates[0]) << c.file;
+    std::printf("%s: %zu of %zu tets outside; sliver candidates %llu -> %llu\n", c.file, outside, run->tets.size(),
+                (unsigned long long)candidates[0], (unsigned long long)candidates[1]);
   }
 }
 
