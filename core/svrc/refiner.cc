@@ -122,6 +122,10 @@ class Refiner {
   absl::StatusOr<bool> SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume,
                                       bool all_vertices = false);
   void CountSizeRound() { ++stats_.size_rounds; }
+  // Set by RefinePlc (docs/svrc-design.md §8 item 34): M_Ω's Skinny test off
+  // until the features conform (features_first); output tets tested per tet
+  // once M_Ω is labelled (tet_quality); max_volume per tet too (set by the
+  // first labelling when the regions' bounds differ, or RefineOptions::tet_sizes).
   bool skinny_deferred_ = false;
   bool tet_mode_ = false;
   bool tet_sizes_ = false;
@@ -400,8 +404,9 @@ class Refiner {
   // test (RefineOptions::features_first, tet_quality).
   double CellTau() const { return skinny_deferred_ || tet_mode_ ? HUGE_VAL : options_.tau; }
   // tet_quality: whether t is an output tet of M_Ω's labelling that is bad
-  // (radius-edge above τ/2 or circumradius above its target); its
-  // circumcentre and radius.
+  // (radius-edge above τ/2, or with tet_sizes_ circumradius above its
+  // target); its circumcentre and radius. Tets whose circumcentre Size()
+  // would not read plainly (flat, outside Ω) are never bad here.
   bool TetBad(TetId t, Vec3* cc, double* radius) const;
   // Enqueues t's Skinny event when TetBad; returns whether it did.
   bool EnqueueTetIfBad(TetId t);
