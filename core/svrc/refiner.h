@@ -216,7 +216,7 @@ struct RefineStats {
   uint64_t predicate_calls = 0;
   uint64_t predicate_exact = 0;    // filter failures → exact arithmetic
   uint64_t predicate_sos = 0;      // exact zero → symbolic perturbation
-  double max_aspect = 0;           // max R_v/r_v over cells at the end
+  double max_aspect = 0;           // max R_v/r_v over cells at the end (0 under tet_quality)
   double seconds = 0;
 
   // Appends the counters to a MeshStats (names "svrc.*").
