@@ -410,6 +410,13 @@ class Refiner {
   bool TetBad(TetId t, Vec3* cc, double* radius) const;
   // Enqueues t's Skinny event when TetBad; returns whether it did.
   bool EnqueueTetIfBad(TetId t);
+  // t's label (tet_labels_) when it is t's own (set or carried for the tet
+  // now in the slot); null otherwise.
+  const TetLabel* LiveLabel(TetId t) const {
+    if (t.value() >= tet_labels_.size()) return nullptr;
+    const TetLabel& lab = tet_labels_[t.value()];
+    return lab.gen == omega_.dt().Generation(t) + 1 ? &lab : nullptr;
+  }
   // WorkEvent::object of a per-tet Skinny event: the tet slot | kTetEvent.
   static constexpr uint32_t kTetEvent = 1u << 31;
   // Skinny, or larger than the size target of max_volume (SetSizeTargets).
@@ -1582,9 +1589,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
 
 bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   const delaunay::Delaunay3& dt = omega_.dt();
-  if (dt.IsGhost(t) || t.value() >= tet_labels_.size()) return false;
-  const TetLabel& lab = tet_labels_[t.value()];
-  if (lab.gen != dt.Generation(t) + 1 || !lab.kept) return false;
+  const TetLabel* lab = dt.IsGhost(t) ? nullptr : LiveLabel(t);
+  if (lab == nullptr || !lab->kept) return false;
   if (!omega_.PlainCorner(t, cc)) return false;
   std::array<Vec3, 4> q;
   for (int k = 0; k < 4; ++k) q[k] = dt.Point(dt.TetVertex(t, k));
@@ -1595,7 +1601,7 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   }
   *radius = r;
   const double rho = 0.5 * options_.tau;
-  return r * r > rho * rho * l2 || (tet_sizes_ && r > lab.target);
+  return r * r > rho * rho * l2 || (tet_sizes_ && r > lab->target);
 }
 
 bool Refiner::EnqueueTetIfBad(TetId t) {
@@ -3036,8 +3042,8 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
       for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
       out.tets.push_back(tet);
       if (labelled) {
-        const bool known = t.value() < tet_labels_.size() && tet_labels_[t.value()].gen == dt.Generation(t) + 1;
-        out.tet_outside.push_back(known && !tet_labels_[t.value()].kept ? 1 : 0);
+        const TetLabel* lab = LiveLabel(t);
+        out.tet_outside.push_back(lab != nullptr && !lab->kept ? 1 : 0);
       }
     }
   }
@@ -3306,7 +3312,10 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   if (!s.ok()) return s;
   if (features_first) {
     refiner.skinny_deferred_ = false;
-    absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume, /*all_vertices=*/true);
+    // Every cell's Skinny test resumes on its kept tets (features_first alone);
+    // under tet_quality the cells only carry size targets, which the
+    // labelling enqueues itself.
+    absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume, /*all_vertices=*/!tet_quality);
     if (!more.ok()) return more.status();
     bool volumes = options.max_volume > 0;
     for (const plc::RegionSeed& sd : complex.regions) volumes = volumes || sd.max_volume > 0;

@@ -48,11 +48,11 @@ struct RefineOptions {
   // then M_Ω labelled (as the size rounds do) and every cell tested on its
   // kept tets only.
   bool features_first = false;
-  // Experimental: once M_Ω is labelled, M_Ω's quality and size are tested
-  // per output tet (radius-edge > τ/2, circumradius > its region's target)
-  // instead of per Voronoi cell; a bad tet's circumball is the gap ball.
-  // Implies features_first. PLCs with facets, no collars, no
-  // keep_bounding_box only.
+  // Once M_Ω is labelled, M_Ω's quality is tested per output tet
+  // (radius-edge > τ/2) instead of per Voronoi cell; a bad tet's circumball
+  // is the gap ball (docs/svrc-design.md §8 item 34). Implies
+  // features_first. PLCs with facets, no collars, no keep_bounding_box only
+  // (the others keep the cell test).
   bool tet_quality = true;
   // With tet_quality, max_volume is tested per output tet (circumradius >
   // the regular tet's of its region's bound) when the output's regions have
