@@ -42,7 +42,7 @@ struct CellSize {
   bool outside_tets = false;  // a star tet is known to lie outside the output
 };
 
-// Per M_Ω tet slot: its region's size target (+inf: none) and whether the
+// Per M_Ω tet slot: its region's size target (+inf: none), volume bound and whether the
 // output keeps it, from the refiner's last labelling and carried to new tets
 // (refiner.cc PropagateSizeTargets). Valid while gen == Generation + 1 (a
 // live tet) or gen == Generation (a tet just freed by an insertion).
@@ -50,6 +50,9 @@ struct TetLabel {
   uint32_t gen = 0;
   double target = HUGE_VAL;
   bool kept = false;
+  // Its region's max_volume in normalised coordinates (+inf: none); read by
+  // the per-tet volume test (RefineOptions::tet_volumes).
+  double volume = HUGE_VAL;
 };
 
 class OmegaMesh {

@@ -404,8 +404,9 @@ class Refiner {
   // test (RefineOptions::features_first, tet_quality).
   double CellTau() const { return skinny_deferred_ || tet_mode_ ? HUGE_VAL : options_.tau; }
   // tet_quality: whether t is an output tet of M_Ω's labelling that is bad
-  // (radius-edge above τ/2, or with tet_sizes_ circumradius above its
-  // target); its circumcentre and radius. Tets whose circumcentre Size()
+  // (radius-edge above τ/2, or with tet_sizes_ its volume above its region's
+  // bound — with tet_volumes — or its circumradius above its target); its
+  // circumcentre and radius. Tets whose circumcentre Size()
   // would not read plainly (flat, outside Ω) are never bad here.
   bool TetBad(TetId t, Vec3* cc, double* radius) const;
   // Enqueues t's Skinny event when TetBad; returns whether it did.
@@ -1601,7 +1602,17 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   }
   *radius = r;
   const double rho = 0.5 * options_.tau;
-  return r * r > rho * rho * l2 || (tet_sizes_ && r > lab->target);
+  if (r * r > rho * rho * l2) return true;
+  if (!tet_sizes_) return false;
+  if (options_.tet_volumes) {
+    // The bound itself, with a relative margin of 1e-9 for the rounding of
+    // this determinant and of the back map to input coordinates (the
+    // output's volumes are computed there).
+    if (lab->volume == HUGE_VAL) return false;
+    const double vol6 = std::fabs(geom::Dot(q[1] - q[0], geom::Cross(q[2] - q[0], q[3] - q[0])));
+    return vol6 > 6.0 * lab->volume * (1 - 1e-9);
+  }
+  return r > lab->target;
 }
 
 bool Refiner::EnqueueTetIfBad(TetId t) {
@@ -1645,7 +1656,8 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
     const TetId c = inserted.created[k];
     const bool known = created_labels_[k].gen != 0;
     const double target = created_labels_[k].target;
-    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target, created_labels_[k].kept};
+    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target, created_labels_[k].kept,
+                              created_labels_[k].volume};
     if (!known || target == HUGE_VAL || dt.IsGhost(c) || tet_sizes_) continue;
     for (int i = 0; i < 4; ++i) {
       const uint32_t v = dt.TetVertex(c, i).value();
@@ -2671,6 +2683,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // The target of each kept tet: the circumradius of a regular tet of its
   // region's volume bound (edge a = (6√2·V)^(1/3), circumradius a·√6/4).
   std::vector<double> tet_target(tets.size(), HUGE_VAL);
+  std::vector<double> tet_volume(tets.size(), HUGE_VAL);  // the bound, normalised
   bool uniform = true;
   double first_target = -1;
   for (size_t t = 0; t < tets.size(); ++t) {
@@ -2679,7 +2692,10 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     const double region = lab->components[lab->tet_component[t]].max_volume;
     if (region > 0) vmax = region;
     if (global_max_volume > 0) vmax = std::min(vmax, global_max_volume);
-    if (vmax != HUGE_VAL) tet_target[t] = std::cbrt(6.0 * std::sqrt(2.0) * vmax * scale3) * std::sqrt(6.0) / 4.0;
+    if (vmax != HUGE_VAL) {
+      tet_target[t] = std::cbrt(6.0 * std::sqrt(2.0) * vmax * scale3) * std::sqrt(6.0) / 4.0;
+      tet_volume[t] = vmax * scale3;
+    }
     if (first_target < 0) first_target = tet_target[t];
     uniform = uniform && tet_target[t] == first_target;
   }
@@ -2689,7 +2705,9 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // of its tets and refines the coarser region along every interface
   // (nested_boxes_3: 4,290 tets instead of 1,152), so the tets are tested
   // against their own targets (§8 item 34).
-  if (tet_mode_ && (!uniform || options_.tet_sizes)) tet_sizes_ = true;
+  // A volume bound is tested per tet on the volume itself (tet_volumes).
+  const bool bounded = !uniform || (first_target >= 0 && first_target != HUGE_VAL);
+  if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
     if (!tet_labels_.empty()) {
       tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL, lab->Kept(static_cast<uint32_t>(t))};
@@ -2697,7 +2715,10 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     if (tet_target[t] == HUGE_VAL) continue;
     const double rt = tet_target[t];
-    if (!tet_labels_.empty()) tet_labels_[tet_ids[t].value()].target = rt;
+    if (!tet_labels_.empty()) {
+      tet_labels_[tet_ids[t].value()].target = rt;
+      tet_labels_[tet_ids[t].value()].volume = tet_volume[t];
+    }
     if (tet_sizes_) continue;
     for (uint32_t v : tets[t]) {
       if (rt < size_target_[v]) {

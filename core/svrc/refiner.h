@@ -59,6 +59,13 @@ struct RefineOptions {
   // different bounds, per cell (the same verdicts, fewer events) when they
   // share one; true: per tet always.
   bool tet_sizes = false;
+  // With tet_quality and a max_volume, each output tet is tested on its
+  // volume against its region's bound (the bound the output must meet),
+  // instead of its circumradius against the regular tet's of that volume
+  // (a cell or tet passing the circumradius test has volume at most the
+  // bound, but most tets above it are still far below the bound). Per tet
+  // always (tet_sizes implied). docs/svrc-design.md §8 item 35.
+  bool tet_volumes = true;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
