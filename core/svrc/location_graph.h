@@ -95,6 +95,17 @@ class LocationGraph {
       if (e[i].kind == ObjectKind::kBall) f(BallId(e[i].object_id));
     }
   }
+  // The balls of the cell's unresolved links only (0-balls whose point is
+  // not yet in the mesh), in link order; f as in ForEachBall.
+  template <typename F>
+  void ForEachUnresolvedBall(MeshId mesh, uint32_t cell, F&& f) const {
+    const Span* cs = FindCellSpan(mesh, cell);
+    if (cs == nullptr || cs->unresolved == 0) return;
+    const CellEntry* e = cell_arena_.Data(*cs);
+    for (uint32_t i = 0, n = cs->size; i < n; ++i) {
+      if (e[i].unresolved && e[i].kind == ObjectKind::kBall) f(BallId(e[i].object_id));
+    }
+  }
   // All objects linked to cell v of mesh F, in link order.
   void ObjectsOf(MeshId mesh, uint32_t cell, std::vector<LocationObject>* out) const;
   // Cells_F'(O): cells of mesh F' linked to O, in link order.

@@ -192,6 +192,30 @@ class Refiner {
     }
   }
 
+  // Destroy's 𝓑 as lines 4–9 of Figure 3.4 read it in M_Ω (c ∈ V(v)): every
+  // ball of v's cell, and only the unresolved 0-balls of the other cells.
+  // Line 9's yields are balls with c strictly inside: such a ball meets
+  // V(v) ∋ c, so it is linked to v. Line 4's warp targets are 0-balls not
+  // yet in M_Ω, each linked (unresolved) to the one cell holding its point.
+  // The other links of the other cells (facet and segment balls near them)
+  // could only be dropped by those tests; PreferWarp/PreferYield are total
+  // orders, so the choice is the one the union of all their balls gives
+  // (§8 item 36).
+  void GatherDestroyBalls(VertexId v, const std::vector<VertexId>& cells, std::vector<BallId>* out) {
+    ++ball_stamp_;
+    if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
+    out->clear();
+    auto add = [&](BallId b) {
+      if (ball_mark_[b.value()] == ball_stamp_) return;
+      ball_mark_[b.value()] = ball_stamp_;
+      out->push_back(b);
+    };
+    blg_.ForEachBall(kOmegaMesh, v.value(), add);
+    for (VertexId u : cells) {
+      if (u != v) blg_.ForEachUnresolvedBall(kOmegaMesh, u.value(), add);
+    }
+  }
+
   // Destroy's choices (Figure 3.4 lines 6 and 13): the warp target with the
   // lowest CD, then nearest to c, then the lowest point id; the yield ball
   // with the lowest CD, then the largest, then the lowest id (determinism).
@@ -1332,7 +1356,12 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     // guide §3). Line 9: 𝒴 = lower-CD balls with c strictly inside.
     BallId warp, yield;
     double warp_d2 = 0;
-    GatherBalls(kOmegaMesh, bfs_, &gathered_);
+    if (options_.destroy_gather_all) {
+      GatherBalls(kOmegaMesh, bfs_, &gathered_);
+    } else {
+      GatherDestroyBalls(v, bfs_, &gathered_);
+    }
+    stats_.destroy_balls_read += gathered_.size();
     for (BallId b : gathered_) {
       if (!(balls_.CdOf(b) < cd_ball)) continue;
       if (balls_.IsVertexBall(b)) {
@@ -3154,6 +3183,9 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.sizes_outside", static_cast<double>(sizes_outside));
   out->Set("svrc.sizes_clipped", static_cast<double>(clipped_cells));
   out->Set("svrc.destroys_local", static_cast<double>(destroys_local));
+  out->Set("svrc.destroy_cells_visited", static_cast<double>(destroy_cells_visited));
+  out->Set("svrc.max_destroy_cells", static_cast<double>(max_destroy_cells));
+  out->Set("svrc.destroy_balls_read", static_cast<double>(destroy_balls_read));
   out->Set("svrc.warps", static_cast<double>(warps));
   out->Set("svrc.yields", static_cast<double>(yields));
   out->Set("svrc.max_yield_chain", static_cast<double>(max_yield_chain));

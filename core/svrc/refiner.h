@@ -66,6 +66,10 @@ struct RefineOptions {
   // bound, but most tets above it are still far below the bound). Per tet
   // always (tet_sizes implied). docs/svrc-design.md §8 item 35.
   bool tet_volumes = true;
+  // Destroy in M_Ω gathers every ball of every cell it visits (Figure 3.4
+  // line 3) instead of v's balls and the other cells' unresolved 0-balls
+  // only (the same choices: docs/svrc-design.md §8 item 36). Tests.
+  bool destroy_gather_all = false;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
@@ -207,6 +211,7 @@ struct RefineStats {
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
   uint64_t destroy_cells_visited = 0;  // |𝒱| summed over Destroy calls
+  uint64_t destroy_balls_read = 0;     // balls Destroy in M_Ω tested for a warp or a yield
   uint64_t destroys_local = 0;     // Destroy in M_Ω with no unresolved 0-ball: 𝒱 = {v}
   uint64_t max_destroy_cells = 0;
   uint64_t buckets_walked = 0;

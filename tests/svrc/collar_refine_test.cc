@@ -391,6 +391,27 @@ TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
   }
 }
 
+// Destroy in M_Ω reads v's balls and the other cells' unresolved 0-balls
+// only (RefineOptions::destroy_gather_all = false, docs/svrc-design.md §8
+// item 36): the same warps and yields as the union of every ball of the
+// cells visited, so the same refinement bit for bit, with fewer balls read.
+// A yield ball not linked to v, or a warp target linked to its cell without
+// the unresolved flag, would change the output here.
+TEST(CollarRefine, DestroyReadsWhatItNeedsWithTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"c_creases/knife_edge.poly", true, 0}, SameRefinementCase{"d_small_angles/segment_fan.poly", true, 0},
+        SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
+        SameRefinementCase{"b_internal/box_in_box.poly", false, 0},
+        SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 0}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->destroy_gather_all = !on; });
+    EXPECT_EQ(runs[0].stats.warps, runs[1].stats.warps) << c.rel;
+    EXPECT_EQ(runs[0].stats.yields, runs[1].stats.yields) << c.rel;
+    EXPECT_LT(runs[1].stats.destroy_balls_read, runs[0].stats.destroy_balls_read) << c.rel;
+    std::printf("%s: Destroy read %llu balls, %llu with every ball of its cells\n", c.rel,
+                (unsigned long long)runs[1].stats.destroy_balls_read, (unsigned long long)runs[0].stats.destroy_balls_read);
+  }
+}
+
 // RefineOptions::propagate_size_targets: max_volume targets carried from a
 // size round's labelling to the tets and points of later cavities. Without
 // it the rounds refine in waves, each labelling finding the last round's new
