@@ -1558,10 +1558,27 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // V(p) ⊂ ∪ V_old(u), so every ball meeting V(p) was linked to some u: p's
   // cell gets the lower balls of 𝒱 that pass the test.
   std::vector<BallId> moved_pieces;
+  // Not on the collar path: its outputs follow the order of the Encroached
+  // events closely (§8 item 37), and that path keeps its measured order.
+  const bool bisector_filter = options_.bisector_link_filter && !options_.collars;
   for (size_t i = 0; i + 1 < changed.size(); ++i) {
     const VertexId u = changed[i];
     const Vec3& pu = dt.Point(u);
+    // V_new(u) lies in the half-space of points nearer to u than to the new
+    // point, which B(c, r) meets only if the signed distance from c to their
+    // bisector, (|uc|² − |pc|²) / (2|up|), is at most r: a ball the insertion
+    // put wholly on the new point's side leaves u whatever R_u is (cells
+    // reaching into Ω's coarse exterior keep R_u large; §8 item 37). The
+    // slack keeps rounding on the side of keeping the link, as
+    // CellsMeetingBall's.
+    const double up = bisector_filter ? geom::Dist(pu, pos) : 0;
+    auto beyond_bisector = [&](BallId b) {
+      const Vec3& c = balls_.Center(b);
+      const double uc2 = geom::Dist2(pu, c);
+      return uc2 - geom::Dist2(pos, c) > 2.0 * balls_.Radius(b) * up * (1 + 1e-9) + 1e-12 * uc2;
+    };
     auto piece_meets = [&](BallId b) {
+      if (bisector_filter && beyond_bisector(b)) return false;
       const double d = geom::Dist(pu, balls_.Center(b));
       if (!exact[i]) {
         // Certified cell: new_at_[i].corner ≤ R_u ≤ cell_cert_[u].outradius.
@@ -1582,6 +1599,11 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     FilterShrunkCell(kOmegaMesh, u.value(), nv.value(), &moved_pieces, piece_meets, nearer_to_new);
   }
   const size_t inew = changed.size() - 1;
+  // With the filter, by ball id: the new cell's links (and the Encroached
+  // events AddBallLink enqueues, FIFO in their bucket) then come in an order
+  // that does not depend on which old cells still held each ball (§8 item
+  // 37).
+  if (bisector_filter) std::sort(moved_pieces.begin(), moved_pieces.end());
   for (BallId b : moved_pieces) {
     if (geom::Dist(pos, balls_.Center(b)) <= (balls_.Radius(b) + sizes[inew].outradius) * (1 + 1e-9)) {
       AddBallLink(nv, b);
@@ -2545,6 +2567,32 @@ absl::Status Refiner::CheckInvariants(bool final) {
   if (!s.ok()) return s;
   if (!blg_.Validate()) return absl::InternalError("SVRC invariant: BLG directions disagree");
   if (!queues_.Validate()) return absl::InternalError("SVRC invariant: work queues corrupt");
+  // Links are conservative (guide §3): a lower ball linked in M_Ω is linked
+  // to the cell holding its centre and to the cell of every vertex strictly
+  // inside it (that vertex's cell meets the ball), whatever filters
+  // UpdateLocation applied (§8 item 37). The candidates are the superset
+  // CellsMeetingBall finds.
+  {
+    std::vector<uint32_t> linked;
+    std::vector<VertexId> near;
+    for (uint32_t i = 0; i < balls_.size(); ++i) {
+      const BallId b(i);
+      if (!balls_.IsAlive(b) || balls_.IsVertexBall(b)) continue;
+      linked.clear();
+      blg_.CellsOf(LocationObject::Ball(b), kOmegaMesh, &linked);
+      if (linked.empty()) continue;
+      std::sort(linked.begin(), linked.end());
+      const VertexId w = dt.NearestVertex(balls_.Center(b), dt.VertexTet(VertexId(linked[0])));
+      CellsMeetingBall(balls_.Center(b), balls_.Radius(b), w, &near);
+      for (VertexId x : near) {
+        if (x != w && !Inside(b, dt.Point(x))) continue;
+        if (!std::binary_search(linked.begin(), linked.end(), x.value())) {
+          return absl::InternalError(absl::StrCat("SVRC invariant: ball ", i, " (", balls_.NumVertices(b),
+                                                  " vertices) meets cell ", x.value(), " but is not linked to it"));
+        }
+      }
+    }
+  }
   // Every unresolved point (input or segment point) is linked to exactly one
   // cell of M_Ω, that cell contains it, and the cell has an Unresolved event.
   for (uint32_t i = 0; i < points_.size(); ++i) {

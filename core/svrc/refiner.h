@@ -70,6 +70,12 @@ struct RefineOptions {
   // line 3) instead of v's balls and the other cells' unresolved 0-balls
   // only (the same choices: docs/svrc-design.md §8 item 36). Tests.
   bool destroy_gather_all = false;
+  // UpdateLocation drops a shrunk cell's link to a lower ball that lies
+  // wholly beyond the bisector of the cell's vertex and the new point, and
+  // links the new cell's balls in ball-id order (docs/svrc-design.md §8 item
+  // 37); false: the B(u, R_u) test alone, in the old cells' link order.
+  // Never with collars.
+  bool bisector_link_filter = true;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
