@@ -157,6 +157,30 @@ TEST(CreaseMesh, FacetPair1) {
   MeshAndCheck(plc::families::CreaseFacetPair(1), "crease_pair_1");
 }
 
+// A creased input at a radius-edge bound the collar path cannot reach within
+// the vertex budget (knife_edge.poly: 84,152 tets at 1.65, the 1,000,000-
+// vertex budget after 60 s at 1.5) ends FAILED_PRECONDITION saying that the
+// bound is the reason, not only that a budget ran out. At 2 the same budget
+// is plenty (5,547 vertices).
+TEST(CreaseMesh, TightBoundOverBudgetSaysWhy) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/knife_edge.poly"));
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  core::MeshParams params;
+  params.max_vertices = 30000;
+  params.radius_edge = 1.5;
+  absl::StatusOr<mesh::TetMesh> tight = core::MeshPlc(*plc, params);
+  ASSERT_FALSE(tight.ok());
+  EXPECT_EQ(tight.status().code(), absl::StatusCode::kFailedPrecondition) << tight.status();
+  EXPECT_NE(tight.status().message().find("vertex budget of 30000"), std::string::npos) << tight.status();
+  EXPECT_NE(tight.status().message().find("radius_edge 1.5 is below 2"), std::string::npos) << tight.status();
+  params.radius_edge = 2;
+  absl::StatusOr<mesh::TetMesh> plain = core::MeshPlc(*plc, params);
+  ASSERT_TRUE(plain.ok()) << plain.status();
+}
+
 // max_volume with collars: the size rounds run after the stitch on the
 // stitched mesh's labelling. Before the stitch the flood leaked through the
 // unsealed collars (knife_edge.poly --max-volume 1e-3 ended INVALID_ARGUMENT
