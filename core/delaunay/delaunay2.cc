@@ -318,14 +318,14 @@ void Delaunay2::StarRaw(uint32_t v, std::vector<uint32_t>* out) const {
 }
 
 void Delaunay2::Star(VertexId v, std::vector<TriId>* out) const {
-  std::vector<uint32_t> raw;
+  std::vector<uint32_t>& raw = raw_scratch_;
   StarRaw(v.value(), &raw);
   out->clear();
   for (uint32_t t : raw) out->push_back(TriId(t));
 }
 
 void Delaunay2::Neighbors(VertexId v, std::vector<VertexId>* out) const {
-  std::vector<uint32_t> raw;
+  std::vector<uint32_t>& raw = raw_scratch_;
   StarRaw(v.value(), &raw);
   out->clear();
   int i = 0;
@@ -352,7 +352,7 @@ double Delaunay2::Circumradius(TriId t) const {
 }
 
 void Delaunay2::VoronoiCorners(VertexId v, std::vector<Vec2>* out) const {
-  std::vector<uint32_t> raw;
+  std::vector<uint32_t>& raw = raw_scratch_;
   StarRaw(v.value(), &raw);
   out->clear();
   for (uint32_t t : raw) out->push_back(Circumcenter(TriId(t)));
@@ -375,7 +375,7 @@ double Delaunay2::OutRadius(VertexId v, Vec2* farthest_corner) const {
 }
 
 double Delaunay2::InRadius(VertexId v) const {
-  std::vector<VertexId> nbrs;
+  std::vector<VertexId>& nbrs = nbrs_scratch_;
   Neighbors(v, &nbrs);
   const Vec2 p = points_[v.value()];
   double best = std::numeric_limits<double>::infinity();
@@ -395,7 +395,7 @@ Delaunay2::VertexId Delaunay2::NearestVertex(Vec2 p, TriId hint) const {
     const uint32_t u = tri_v_[3 * t.value() + i];
     if (closer(u, best)) best = u;
   }
-  std::vector<VertexId> nbrs;
+  std::vector<VertexId>& nbrs = nbrs_scratch_;
   bool moved = true;
   while (moved) {
     moved = false;

@@ -186,6 +186,14 @@ class Delaunay2 {
   uint32_t free_head_ = kFreeSlot;  // free list threaded through tri_n_[3t]
   uint32_t num_live_ = 0;
   uint32_t last_tri_ = 0;
+  // Scratch of the const star queries (Star, Neighbors, VoronoiCorners,
+  // InRadius, NearestVertex), reused instead of a vector per call (300,000
+  // allocations on cube.poly --max-volume 1e-4). Each is used within one
+  // call and none of those calls another that uses the same buffer; like
+  // tri_mark_, it makes concurrent queries of one Delaunay2 unsafe (a job
+  // owns its meshes).
+  mutable std::vector<uint32_t> raw_scratch_;
+  mutable std::vector<VertexId> nbrs_scratch_;
   mutable std::vector<uint32_t> tri_mark_;
   mutable uint32_t tri_stamp_ = 0;
   mutable std::vector<uint32_t> vertex_mark_;
