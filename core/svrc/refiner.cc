@@ -619,6 +619,15 @@ class Refiner {
   std::vector<uint32_t> cert_mark_, cert_pos_;
   uint32_t cert_stamp_ = 0;
   std::vector<uint8_t> drop_;          // UpdateLocation: links of a shrunk cell to remove
+  // ForceInsertOmega's 𝒱', sizes, exactness and lower balls, and
+  // LinkBallToOmega's cells: scratch reused across insertions (neither
+  // function is re-entered while it uses them; ForceInsertOmega's only
+  // nested insertion, CreateCollar, is its last step).
+  std::vector<VertexId> insert_changed_;
+  std::vector<CellSize> insert_sizes_;
+  std::vector<uint8_t> insert_exact_;
+  std::vector<BallId> insert_moved_;
+  std::vector<VertexId> link_cells_;
 };
 
 absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments) {
@@ -966,7 +975,7 @@ void Refiner::AddBallLink(VertexId x, BallId b) {
 void Refiner::LinkBallToOmega(BallId b, VertexId start) {
   const delaunay::Delaunay3& dt = omega_.dt();
   const VertexId w = dt.NearestVertex(balls_.Center(b), dt.VertexTet(start));
-  std::vector<VertexId> cells;
+  std::vector<VertexId>& cells = link_cells_;
   CellsMeetingBall(balls_.Center(b), balls_.Radius(b), w, &cells);
   for (VertexId x : cells) AddBallLink(x, b);
 }
@@ -1447,7 +1456,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   if (own.valid()) blg_.RemoveObjectLinks(LocationObject::Ball(own), kOmegaMesh, nullptr);
   // 𝒱 = cavity vertices, 𝒱' = 𝒱 ∪ {p}. Copy: the span points into Delaunay3
   // scratch, which later queries reuse.
-  std::vector<VertexId> changed(result.cavity_vertices.begin(), result.cavity_vertices.end());
+  std::vector<VertexId>& changed = insert_changed_;
+  changed.assign(result.cavity_vertices.begin(), result.cavity_vertices.end());
   changed.push_back(nv);
   for (VertexId u : changed) omega_.BumpCell(u);
   if (!tet_labels_.empty()) PropagateSizeTargets(result);
@@ -1494,8 +1504,10 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
       new_at_[cert_pos_[u.value()]].Add(plain ? geom::Dist(cc, dt.Point(u)) : HUGE_VAL, outside);
     }
   }
-  std::vector<CellSize> sizes(changed.size());
-  std::vector<uint8_t> exact(changed.size(), 1);
+  std::vector<CellSize>& sizes = insert_sizes_;
+  sizes.assign(changed.size(), CellSize{});
+  std::vector<uint8_t>& exact = insert_exact_;
+  exact.assign(changed.size(), 1);
   auto set_size = [&](size_t i) {
     const VertexId u = changed[i];
     exact[i] = 1;
@@ -1557,7 +1569,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // again: ~140 link operations per insertion on cube.poly --max-volume 1e-5).
   // V(p) ⊂ ∪ V_old(u), so every ball meeting V(p) was linked to some u: p's
   // cell gets the lower balls of 𝒱 that pass the test.
-  std::vector<BallId> moved_pieces;
+  std::vector<BallId>& moved_pieces = insert_moved_;
+  moved_pieces.clear();
   // Not on the collar path: its outputs follow the order of the Encroached
   // events closely (§8 item 37), and that path keeps its measured order.
   const bool bisector_filter = options_.bisector_link_filter && !options_.collars;
