@@ -1612,11 +1612,12 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     FilterShrunkCell(kOmegaMesh, u.value(), nv.value(), &moved_pieces, piece_meets, nearer_to_new);
   }
   const size_t inew = changed.size() - 1;
-  // With the filter, by ball id: the new cell's links (and the Encroached
-  // events AddBallLink enqueues, FIFO in their bucket) then come in an order
-  // that does not depend on which old cells still held each ball (§8 item
-  // 37).
-  if (bisector_filter) std::sort(moved_pieces.begin(), moved_pieces.end());
+  // With the filter, newest ball first (descending id): the new cell's links
+  // (and the Encroached events AddBallLink enqueues, FIFO in their bucket)
+  // then come in an order that does not depend on which old cells still
+  // held each ball. Of the orders measured, newest first gave the fewest
+  // tets (§8 item 37).
+  if (bisector_filter) std::sort(moved_pieces.begin(), moved_pieces.end(), [](BallId a, BallId b) { return b < a; });
   for (BallId b : moved_pieces) {
     if (geom::Dist(pos, balls_.Center(b)) <= (balls_.Radius(b) + sizes[inew].outradius) * (1 + 1e-9)) {
       AddBallLink(nv, b);
