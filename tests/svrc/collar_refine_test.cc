@@ -7,12 +7,14 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <optional>
 #include <map>
 #include <set>
 #include <tuple>
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "core/plc/families.h"
 #include "core/plc/features.h"
 #include "core/plc/readers.h"
@@ -413,6 +415,39 @@ TEST(CollarRefine, DestroyReadsWhatItNeedsWithTheSameRefinement) {
   }
 }
 
+// The corpus file `file`, or families::NestedBoxes(3, 1e-2, 1/8) (three
+// regions with max volumes 1e-2, 1.25e-3, 1.5625e-4) for "nested".
+absl::StatusOr<plc::Plc> CaseInput(const std::string& file) {
+  if (file == "nested") return plc::families::NestedBoxes(3, 1e-2, 1.0 / 8);
+  return plc::ReadPlcFile(testing::CorpusPath(file));
+}
+
+// RefinePlc(cx, opt) and its output mesh, checked: conforming, radius-edge
+// ≤ 2 on every tet. nullopt (with a failure) when a stage fails.
+struct RefinedMesh {
+  PointSetRefinement run;
+  mesh::TetMesh mesh;
+};
+std::optional<RefinedMesh> RefineAndCheck(const plc::Plc& plc, const plc::FeatureComplex& cx, const RefineOptions& opt,
+                                          const std::string& what) {
+  absl::StatusOr<PointSetRefinement> run = RefinePlc(cx, opt);
+  if (!run.ok()) {
+    ADD_FAILURE() << what << ": " << run.status();
+    return std::nullopt;
+  }
+  const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, cx);
+  absl::StatusOr<OutputStageResult> out = BuildOutputMesh(plc, run->normalised_positions, run->tets,
+                                                          cx.point_of_vertex, faces, CoordinateMapOf(*run), false);
+  if (!out.ok()) {
+    ADD_FAILURE() << what << ": " << out.status();
+    return std::nullopt;
+  }
+  const mesh::ConformityReport rep = mesh::CheckConformity(plc, out->mesh);
+  EXPECT_TRUE(rep.ok()) << what << ": " << rep.Summary();
+  EXPECT_LE(mesh::ComputeQuality(out->mesh).all.radius_edge.max, 2.0 * (1 + 1e-9)) << what;
+  return RefinedMesh{*std::move(run), std::move(out->mesh)};
+}
+
 // UpdateLocation's bisector filter (RefineOptions::bisector_link_filter,
 // docs/svrc-design.md §8 item 37): a shrunk cell drops its link to a lower
 // ball lying wholly beyond the bisector of its vertex and the new point.
@@ -431,7 +466,7 @@ TEST(CollarRefine, BisectorLinkFilterKeepsLinksConservative) {
   };
   for (const Case& c : {Case{"a_convex/cube.poly", 1e-3}, Case{"b_internal/box_internal_facet.poly", 1e-3},
                         Case{"b_internal/box_in_box.poly", 0}, Case{"e_spread/far_offset_close_points.poly", 0}}) {
-    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.rel));
+    absl::StatusOr<plc::Plc> plc = CaseInput(c.rel);
     ASSERT_TRUE(plc.ok()) << plc.status();
     absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
     ASSERT_TRUE(cx.ok()) << cx.status();
@@ -441,16 +476,9 @@ TEST(CollarRefine, BisectorLinkFilterKeepsLinksConservative) {
       opt.max_volume = c.max_volume;
       opt.bisector_link_filter = on == 1;
       opt.validate_every = kSanitized ? 0 : 97;
-      absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
-      ASSERT_TRUE(run.ok()) << c.rel << ": " << run.status();
-      left[on] = run->stats.links_added - run->stats.links_removed;
-      const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
-      absl::StatusOr<OutputStageResult> out = BuildOutputMesh(*plc, run->normalised_positions, run->tets,
-                                                              cx->point_of_vertex, faces, CoordinateMapOf(*run), false);
-      ASSERT_TRUE(out.ok()) << c.rel << ": " << out.status();
-      const mesh::ConformityReport rep = mesh::CheckConformity(*plc, out->mesh);
-      EXPECT_TRUE(rep.ok()) << c.rel << " filter " << on << ": " << rep.Summary();
-      EXPECT_LE(mesh::ComputeQuality(out->mesh).all.radius_edge.max, 2.0 * (1 + 1e-9)) << c.rel;
+      const std::optional<RefinedMesh> r = RefineAndCheck(*plc, *cx, opt, absl::StrCat(c.rel, " filter ", on));
+      ASSERT_TRUE(r.has_value());
+      left[on] = r->run.stats.links_added - r->run.stats.links_removed;
     }
     EXPECT_LT(left[1], left[0]) << c.rel;
     std::printf("%s: links left at the end %llu without the filter, %llu with\n", c.rel, (unsigned long long)left[0],
@@ -538,9 +566,7 @@ TEST(CollarRefine, TetQualityMeetsTheBoundWithFewerTets) {
     // targets differ: 4,165 tets with the cell tests, 1,152 (tetgen -pq2a:
     // 1,690); each tet's volume bound is checked by
     // PlcRefine.MaxVolumeGlobalAndPerRegion.
-    absl::StatusOr<plc::Plc> plc = std::string(c.file) == "nested"
-                                       ? absl::StatusOr<plc::Plc>(plc::families::NestedBoxes(3, 1e-2, 1.0 / 8))
-                                       : plc::ReadPlcFile(testing::CorpusPath(c.file));
+    absl::StatusOr<plc::Plc> plc = CaseInput(c.file);
     ASSERT_TRUE(plc.ok()) << plc.status();
     absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
     ASSERT_TRUE(cx.ok()) << cx.status();
@@ -549,17 +575,9 @@ TEST(CollarRefine, TetQualityMeetsTheBoundWithFewerTets) {
       RefineOptions opt;
       opt.tet_quality = per_tet == 1;
       opt.validate_every = per_tet == 1 && !kSanitized ? c.validate_every : 0;
-      absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
-      ASSERT_TRUE(run.ok()) << c.file << ": " << run.status();
-      const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
-      absl::StatusOr<OutputStageResult> out = BuildOutputMesh(*plc, run->normalised_positions, run->tets,
-                                                              cx->point_of_vertex, faces, CoordinateMapOf(*run), false);
-      ASSERT_TRUE(out.ok()) << c.file << ": " << out.status();
-      const mesh::ConformityReport rep = mesh::CheckConformity(*plc, out->mesh);
-      EXPECT_TRUE(rep.ok()) << c.file << " per_tet " << per_tet << ": " << rep.Summary();
-      const mesh::QualityReport q = mesh::ComputeQuality(out->mesh);
-      EXPECT_LE(q.all.radius_edge.max, 2.0 * (1 + 1e-9)) << c.file << " per_tet " << per_tet;
-      tets[per_tet] = out->mesh.tets.size();
+      const std::optional<RefinedMesh> r = RefineAndCheck(*plc, *cx, opt, absl::StrCat(c.file, " per_tet ", per_tet));
+      ASSERT_TRUE(r.has_value());
+      tets[per_tet] = r->mesh.tets.size();
     }
     EXPECT_LT(static_cast<double>(tets[1]), c.max_ratio * static_cast<double>(tets[0])) << c.file;
     std::printf("%s: %zu tets with the cell test, %zu with the per-tet test\n", c.file, tets[0], tets[1]);
@@ -585,9 +603,7 @@ TEST(CollarRefine, VolumeTestMeetsTheBoundWithFewerTets) {
                         Case{"nested", 0, 1.0}}) {
     // nested: three regions with max volumes 1e-2, 1.25e-3, 1.5625e-4; its
     // small boxes' radius-edge and grading set most sizes (1,179 → 1,159).
-    absl::StatusOr<plc::Plc> plc = std::string(c.file) == "nested"
-                                       ? absl::StatusOr<plc::Plc>(plc::families::NestedBoxes(3, 1e-2, 1.0 / 8))
-                                       : plc::ReadPlcFile(testing::CorpusPath(c.file));
+    absl::StatusOr<plc::Plc> plc = CaseInput(c.file);
     ASSERT_TRUE(plc.ok()) << plc.status();
     absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
     ASSERT_TRUE(cx.ok()) << cx.status();
@@ -597,17 +613,9 @@ TEST(CollarRefine, VolumeTestMeetsTheBoundWithFewerTets) {
       opt.max_volume = c.max_volume;
       opt.tet_volumes = volumes == 1;
       opt.validate_every = volumes == 1 && !kSanitized ? 256 : 0;
-      absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
-      ASSERT_TRUE(run.ok()) << c.file << ": " << run.status();
-      const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
-      absl::StatusOr<OutputStageResult> out = BuildOutputMesh(*plc, run->normalised_positions, run->tets,
-                                                              cx->point_of_vertex, faces, CoordinateMapOf(*run), false);
-      ASSERT_TRUE(out.ok()) << c.file << ": " << out.status();
-      const mesh::TetMesh& m = out->mesh;
-      const mesh::ConformityReport rep = mesh::CheckConformity(*plc, m);
-      EXPECT_TRUE(rep.ok()) << c.file << " volumes " << volumes << ": " << rep.Summary();
-      const mesh::QualityReport q = mesh::ComputeQuality(m);
-      EXPECT_LE(q.all.radius_edge.max, 2.0 * (1 + 1e-9)) << c.file << " volumes " << volumes;
+      const std::optional<RefinedMesh> r = RefineAndCheck(*plc, *cx, opt, absl::StrCat(c.file, " volumes ", volumes));
+      ASSERT_TRUE(r.has_value());
+      const mesh::TetMesh& m = r->mesh;
       ASSERT_EQ(m.tet_region.size(), m.tets.size()) << c.file;
       size_t over = 0;
       for (size_t t = 0; t < m.tets.size(); ++t) {
