@@ -76,6 +76,12 @@ struct RefineOptions {
   // 37); false: the B(u, R_u) test alone, in the old cells' link order.
   // Never with collars.
   bool bisector_link_filter = true;
+  // With tet_quality, after the refinement (and BreakFlatTets): every kept
+  // tet whose smallest dihedral angle is below this many degrees has its
+  // circumcentre destroyed, then Run() again; at most 4 rounds. The flip
+  // pass (sliver.h) fixes most slivers but leaves a few it cannot flip
+  // (docs/svrc-design.md §8 item 38). 0: off.
+  double sliver_break_deg = 5;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
@@ -213,6 +219,7 @@ struct RefineStats {
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
+  uint64_t slivers_broken = 0;     // kept slivers broken by an insertion at the end (per-tet mode)
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};

@@ -636,6 +636,52 @@ TEST(CollarRefine, VolumeTestMeetsTheBoundWithFewerTets) {
   }
 }
 
+// RefineOptions::sliver_break_deg (docs/svrc-design.md §8 item 38): after
+// the per-tet refinement, kept tets below 5° whose circumcentre would be
+// inserted as is get it inserted. example.poly at radius-edge 1.414 kept one
+// tet at 3.16° through the flip pass (session 14's volume test and link
+// order); with the round its smallest dihedral is 15.0°. Checked on the
+// output after the flip pass, as core::MeshPlc runs it: conforming, radius-
+// edge ≤ 1.414, at most 5% more tets.
+TEST(CollarRefine, SliverRoundLiftsTheSmallestDihedral) {
+  absl::StatusOr<plc::Plc> plc = CaseInput("b_internal/example.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+  ASSERT_TRUE(cx.ok()) << cx.status();
+  double min_dihedral[2] = {0, 0};
+  size_t tets[2] = {0, 0};
+  for (int round = 0; round < 2; ++round) {
+    RefineOptions opt;
+    opt.tau = 2 * 1.414;
+    opt.attempt_creases = true;  // its 63° crease is refined through, as core::MeshPlc does
+    opt.sliver_break_deg = round == 1 ? 5 : 0;
+    absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+    ASSERT_TRUE(run.ok()) << run.status();
+    EXPECT_EQ(run->stats.slivers_broken > 0, round == 1);
+    const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
+    SliverOptions so;
+    so.max_radius_edge = 1.414;
+    so.skip_tet = run->tet_outside;
+    so.keep_max_volume = true;
+    absl::StatusOr<SliverResult> flipped =
+        RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so);
+    ASSERT_TRUE(flipped.ok()) << flipped.status();
+    absl::StatusOr<OutputStageResult> out = BuildOutputMesh(*plc, run->normalised_positions, flipped->tets,
+                                                            cx->point_of_vertex, faces, CoordinateMapOf(*run), false);
+    ASSERT_TRUE(out.ok()) << out.status();
+    const mesh::ConformityReport rep = mesh::CheckConformity(*plc, out->mesh);
+    EXPECT_TRUE(rep.ok()) << "round " << round << ": " << rep.Summary();
+    const mesh::QualityReport q = mesh::ComputeQuality(out->mesh);
+    EXPECT_LE(q.all.radius_edge.max, 1.414 * (1 + 1e-9)) << "round " << round;
+    min_dihedral[round] = q.all.dihedral_deg.min;
+    tets[round] = out->mesh.tets.size();
+  }
+  EXPECT_GE(min_dihedral[1], 5.0);
+  EXPECT_LE(static_cast<double>(tets[1]), 1.05 * static_cast<double>(tets[0]));
+  std::printf("example.poly at 1.414: smallest dihedral %.2f without the round (%zu tets), %.2f with (%zu tets)\n",
+              min_dihedral[0], tets[0], min_dihedral[1], tets[1]);
+}
+
 // PointSetRefinement::tet_outside (the refiner's labels, kept up to the end
 // once M_Ω is labelled) lets the sliver pass skip ∂Ω's exterior
 // (SliverOptions::skip_tet). Flips never cross a constrained face, so the
