@@ -86,6 +86,18 @@ constexpr size_t kLocalDestroyCells = 64;
 
 Vec2 Mid2(Vec2 a, Vec2 b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}; }
 double HalfLen2(Vec2 a, Vec2 b) { return 0.5 * std::hypot(a.x - b.x, a.y - b.y); }
+// 6|V| of tet x, and the cube of its longest edge: their ratio is the
+// flatness BreakFlatTets and BreakSlivers screen tets by.
+double Volume6(const std::array<Vec3, 4>& x) {
+  return std::fabs(geom::Dot(x[1] - x[0], geom::Cross(x[2] - x[0], x[3] - x[0])));
+}
+double LongestEdgeCubed(const std::array<Vec3, 4>& x) {
+  double l2 = 0;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i + 1; j < 4; ++j) l2 = std::max(l2, geom::Dist2(x[i], x[j]));
+  }
+  return l2 * std::sqrt(l2);
+}
 
 class Refiner {
  public:
@@ -185,16 +197,23 @@ class Refiner {
   // once, in link order (shared by the Ω and facet Destroy).
   template <typename Cell>
   void GatherBalls(MeshId mesh, const std::vector<Cell>& cells, std::vector<BallId>* out) {
+    CollectBalls(out, [&](const auto& add) {
+      for (Cell u : cells) blg_.ForEachBall(mesh, u.value(), add);
+    });
+  }
+  // *out = the balls visit(add) passes to add, each once, in first-seen
+  // order (ball_mark_/ball_stamp_).
+  template <typename Visit>
+  void CollectBalls(std::vector<BallId>* out, Visit&& visit) {
     ++ball_stamp_;
     if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
     out->clear();
-    for (Cell u : cells) {
-      blg_.ForEachBall(mesh, u.value(), [&](BallId b) {
-        if (ball_mark_[b.value()] == ball_stamp_) return;
-        ball_mark_[b.value()] = ball_stamp_;
-        out->push_back(b);
-      });
-    }
+    auto add = [&](BallId b) {
+      if (ball_mark_[b.value()] == ball_stamp_) return;
+      ball_mark_[b.value()] = ball_stamp_;
+      out->push_back(b);
+    };
+    visit(add);
   }
 
   // Destroy's 𝓑 as lines 4–9 of Figure 3.4 read it in M_Ω (c ∈ V(v)): every
@@ -207,18 +226,12 @@ class Refiner {
   // orders, so the choice is the one the union of all their balls gives
   // (§8 item 36).
   void GatherDestroyBalls(VertexId v, const std::vector<VertexId>& cells, std::vector<BallId>* out) {
-    ++ball_stamp_;
-    if (ball_mark_.size() < balls_.size()) ball_mark_.resize(balls_.size() + 64, 0);
-    out->clear();
-    auto add = [&](BallId b) {
-      if (ball_mark_[b.value()] == ball_stamp_) return;
-      ball_mark_[b.value()] = ball_stamp_;
-      out->push_back(b);
-    };
-    blg_.ForEachBall(kOmegaMesh, v.value(), add);
-    for (VertexId u : cells) {
-      if (u != v) blg_.ForEachUnresolvedBall(kOmegaMesh, u.value(), add);
-    }
+    CollectBalls(out, [&](const auto& add) {
+      blg_.ForEachBall(kOmegaMesh, v.value(), add);
+      for (VertexId u : cells) {
+        if (u != v) blg_.ForEachUnresolvedBall(kOmegaMesh, u.value(), add);
+      }
+    });
   }
 
   // Destroy's choices (Figure 3.4 lines 6 and 13): the warp target with the
@@ -1679,8 +1692,7 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
     // this determinant and of the back map to input coordinates (the
     // output's volumes are computed there).
     if (lab->volume == HUGE_VAL) return false;
-    const double vol6 = std::fabs(geom::Dot(q[1] - q[0], geom::Cross(q[2] - q[0], q[3] - q[0])));
-    return vol6 > 6.0 * lab->volume * (1 - 1e-9);
+    return Volume6(q) > 6.0 * lab->volume * (1 - 1e-9);
   }
   return r > lab->target;
 }
@@ -2776,24 +2788,21 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // Cells are sized on the output's tets from now on (item 33); the memos
   // of Size() drop.
   omega_.SetLabels(!tet_labels_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_labels_ : nullptr);
-  // The target of each kept tet: the circumradius of a regular tet of its
-  // region's volume bound (edge a = (6√2·V)^(1/3), circumradius a·√6/4).
-  std::vector<double> tet_target(tets.size(), HUGE_VAL);
-  std::vector<double> tet_volume(tets.size(), HUGE_VAL);  // the bound, normalised
+  // The volume bound of each kept tet's region, normalised; its size target
+  // (below) is the circumradius of a regular tet of that volume (edge a =
+  // (6√2·V)^(1/3), circumradius a·√6/4).
+  std::vector<double> tet_volume(tets.size(), HUGE_VAL);
   bool uniform = true;
-  double first_target = -1;
+  double first_volume = -1;
   for (size_t t = 0; t < tets.size(); ++t) {
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     double vmax = HUGE_VAL;
     const double region = lab->components[lab->tet_component[t]].max_volume;
     if (region > 0) vmax = region;
     if (global_max_volume > 0) vmax = std::min(vmax, global_max_volume);
-    if (vmax != HUGE_VAL) {
-      tet_target[t] = std::cbrt(6.0 * std::sqrt(2.0) * vmax * scale3) * std::sqrt(6.0) / 4.0;
-      tet_volume[t] = vmax * scale3;
-    }
-    if (first_target < 0) first_target = tet_target[t];
-    uniform = uniform && tet_target[t] == first_target;
+    if (vmax != HUGE_VAL) tet_volume[t] = vmax * scale3;  // exact: scale3 is a power of two
+    if (first_volume < 0) first_volume = tet_volume[t];
+    uniform = uniform && tet_volume[t] == first_volume;
   }
   // With one target for every output tet, "some kept tet at v is above it"
   // is "R_v of v's kept tets is above it": the cell test flags the same tets
@@ -2802,15 +2811,15 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // (nested_boxes_3: 4,290 tets instead of 1,152), so the tets are tested
   // against their own targets (§8 item 34).
   // A volume bound is tested per tet on the volume itself (tet_volumes).
-  const bool bounded = !uniform || (first_target >= 0 && first_target != HUGE_VAL);
+  const bool bounded = !uniform || (first_volume >= 0 && first_volume != HUGE_VAL);
   if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
     if (!tet_labels_.empty()) {
       tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL, lab->Kept(static_cast<uint32_t>(t))};
     }
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
-    if (tet_target[t] == HUGE_VAL) continue;
-    const double rt = tet_target[t];
+    if (tet_volume[t] == HUGE_VAL) continue;
+    const double rt = std::cbrt(6.0 * std::sqrt(2.0) * tet_volume[t]) * std::sqrt(6.0) / 4.0;
     if (!tet_labels_.empty()) {
       tet_labels_[tet_ids[t].value()].target = rt;
       tet_labels_[tet_ids[t].value()].volume = tet_volume[t];
@@ -2857,12 +2866,7 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg) {
     if (lab == nullptr || !lab->kept) continue;
     std::array<Vec3, 4> x;
     for (int k = 0; k < 4; ++k) x[k] = dt.Point(dt.TetVertex(t, k));
-    double l2 = 0;
-    for (int a = 0; a < 4; ++a) {
-      for (int b = a + 1; b < 4; ++b) l2 = std::max(l2, geom::Dist2(x[a], x[b]));
-    }
-    const double vol6 = std::fabs(geom::Dot(x[1] - x[0], geom::Cross(x[2] - x[0], x[3] - x[0])));
-    if (vol6 > l2 * std::sqrt(l2) * sin_min) continue;
+    if (Volume6(x) > LongestEdgeCubed(x) * sin_min) continue;
     if (!(MeasureSliverTet(x[0], x[1], x[2], x[3]).min_dihedral_deg < min_deg)) continue;
     Vec3 cc;
     if (!omega_.PlainCorner(t, &cc)) continue;
@@ -2916,12 +2920,7 @@ absl::StatusOr<bool> Refiner::BreakFlatTets() {
       x[k] = dt.Point(dt.TetVertex(t, k));
       q[k] = omega_.PointOf(dt.TetVertex(t, k));
     }
-    const double vol6 = std::fabs(geom::Dot(x[1] - x[0], geom::Cross(x[2] - x[0], x[3] - x[0])));
-    double l2 = 0;
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i + 1; j < 4; ++j) l2 = std::max(l2, geom::Dist2(x[i], x[j]));
-    }
-    if (vol6 > 1e-6 * l2 * std::sqrt(l2)) continue;
+    if (Volume6(x) > 1e-6 * LongestEdgeCubed(x)) continue;
     bool boxed = false;
     for (int axis = 0; axis < 3 && !boxed; ++axis) {
       for (int side = 0; side < 2 && !boxed; ++side) {
