@@ -24,6 +24,7 @@
 // Internal: --one cube V | skew n V | spread k | file PATH  (one run, prints
 // one "RESULT key=value ..." line).
 #include <fcntl.h>
+#include <malloc.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/time.h>
@@ -32,6 +33,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -41,6 +43,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <new>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -56,6 +59,53 @@
 #include "core/plc/validate.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
+
+// Heap accounting of this process: every operator new/delete goes through
+// malloc, and the bytes malloc hands out (malloc_usable_size) are counted, with
+// their high-water mark. "peak heap" is that mark during one run minus the
+// bytes live at its start: the data structures' own bytes, without the code
+// pages, libraries and allocator slack that RSS also holds (a run of 10^4 tets
+// peaks at ~14 MB RSS above its start, so a few MB of those shift its ratio).
+namespace {
+std::atomic<int64_t> g_heap_now{0};
+std::atomic<int64_t> g_heap_peak{0};
+void* CountedAlloc(size_t n) {
+  void* p = std::malloc(n == 0 ? 1 : n);
+  if (p == nullptr) throw std::bad_alloc();
+  const int64_t now = g_heap_now.fetch_add(static_cast<int64_t>(malloc_usable_size(p)), std::memory_order_relaxed) +
+                      static_cast<int64_t>(malloc_usable_size(p));
+  int64_t peak = g_heap_peak.load(std::memory_order_relaxed);
+  while (now > peak && !g_heap_peak.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
+  }
+  return p;
+}
+void CountedFree(void* p) {
+  if (p == nullptr) return;
+  g_heap_now.fetch_sub(static_cast<int64_t>(malloc_usable_size(p)), std::memory_order_relaxed);
+  std::free(p);
+}
+}  // namespace
+
+void* operator new(size_t n) { return CountedAlloc(n); }
+void* operator new[](size_t n) { return CountedAlloc(n); }
+void* operator new(size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return CountedAlloc(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return CountedAlloc(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void operator delete(void* p) noexcept { CountedFree(p); }
+void operator delete[](void* p) noexcept { CountedFree(p); }
+void operator delete(void* p, size_t) noexcept { CountedFree(p); }
+void operator delete[](void* p, size_t) noexcept { CountedFree(p); }
 
 namespace svrc::bench {
 namespace {
@@ -100,6 +150,8 @@ bool SameMesh(const mesh::TetMesh& a, const mesh::TetMesh& b) {
 // status=... message=..." on failure) to stdout.
 int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify) {
   const long base_kib = RssKib();
+  const int64_t heap_base = g_heap_now.load();
+  g_heap_peak.store(heap_base);
   plc::Plc plc;
   double max_volume = 0;
   const std::string kind = args.empty() ? "" : args[0];
@@ -157,6 +209,7 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   }
   const double w3 = WallNow(), c3 = CpuNow();
   const long peak_kib = PeakRssKib();  // before the measurements below allocate
+  const int64_t heap_peak = g_heap_peak.load() - heap_base;
 
   const refine::RefineStats& s = refined->stats;
   const mesh::TetMesh& m = out->mesh;
@@ -174,13 +227,13 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
       "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu links_added=%llu "
       "links_removed=%llu warps=%llu yields=%llu max_degree=%u "
       "wall_prepare=%.6f wall_refine=%.6f wall_output=%.6f cpu_prepare=%.6f cpu_refine=%.6f cpu_output=%.6f "
-      "base_kib=%ld peak_kib=%ld max_re=%.6g min_dih=%.6g verify=%s\n",
+      "base_kib=%ld peak_kib=%ld heap_peak=%lld max_re=%.6g min_dih=%.6g verify=%s\n",
       m.positions.size(), m.tets.size(), (unsigned long long)s.vertices, refined->tets.size(),
       (unsigned long long)s.segment_vertices, (unsigned long long)s.facet_vertices,
       (unsigned long long)s.insertions, (unsigned long long)s.destroy_cells_visited,
       (unsigned long long)s.links_added, (unsigned long long)s.links_removed, (unsigned long long)s.warps,
       (unsigned long long)s.yields, s.max_degree, w1 - w0, w2 - w1, w3 - w2, c1 - c0, c2 - c1, c3 - c2,
-      base_kib, peak_kib, q.all.radius_edge.max, q.all.dihedral_deg.min, verified.c_str());
+      base_kib, peak_kib, static_cast<long long>(heap_peak), q.all.radius_edge.max, q.all.dihedral_deg.min, verified.c_str());
   return 0;
 }
 
@@ -305,7 +358,7 @@ std::string G(double v) {
 struct Row {
   std::string series, param;
   RunResult r;
-  double tets = 0, cpu = 0, wall = 0, touched = 0, peak_b = 0, alloc_b = 0;
+  double tets = 0, cpu = 0, wall = 0, touched = 0, peak_b = 0, alloc_b = 0, heap_b = 0;
   double k = 0;  // spread: log10 of 1/side
 };
 
@@ -313,8 +366,8 @@ void PrintHeader() {
   std::printf(
       "| series | parameter | result | output vertices | output tets | M_Ω vertices | M_Ω tets | insertions | wall s | "
       "cpu s (prepare/refine/output) | cpu µs/tet | wall µs/tet | cells+links per insertion (cells, links) | "
-      "peak RSS MiB | peak B/tet | (peak − start) B/tet | max r/e | min dih | MeshPlc same |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "peak RSS MiB | peak B/tet | (peak − start) B/tet | peak heap B/tet | max r/e | min dih | MeshPlc same |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
 }
 
 Row Measure(const std::string& series, const std::string& param, const std::vector<std::string>& one_args,
@@ -326,7 +379,7 @@ Row Measure(const std::string& series, const std::string& param, const std::vect
   row.r = Spawn(one_args, radius_edge, verify, timeout_s, mem_mib);
   const RunResult& r = row.r;
   if (r.status != "OK") {
-    std::printf("| %s | %s | %s | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - |\n", series.c_str(),
+    std::printf("| %s | %s | %s | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - | - |\n", series.c_str(),
                 param.c_str(), r.status.c_str());
     std::fflush(stdout);
     return row;
@@ -339,15 +392,16 @@ Row Measure(const std::string& series, const std::string& param, const std::vect
   row.touched = (cells + links) / ins;
   row.peak_b = r.D("peak_kib") * 1024.0 / row.tets;
   row.alloc_b = (r.D("peak_kib") - r.D("base_kib")) * 1024.0 / row.tets;
+  row.heap_b = r.D("heap_peak") / row.tets;
   std::printf(
       "| %s | %s | ok | %.0f | %.0f | %.0f | %.0f | %.0f | %s | %s (%s/%s/%s) | %s | %s | %s (%s, %s) | %s | %s | %s | %s "
-      "| %s | %s |\n",
+      "| %s | %s | %s |\n",
       series.c_str(), param.c_str(), r.D("out_vertices"), row.tets, r.D("omega_vertices"), r.D("omega_tets"), ins,
       F(row.wall, 2).c_str(), F(row.cpu, 2).c_str(), F(r.D("cpu_prepare"), 2).c_str(),
       F(r.D("cpu_refine"), 2).c_str(), F(r.D("cpu_output"), 2).c_str(), F(1e6 * row.cpu / row.tets, 2).c_str(),
       F(1e6 * row.wall / row.tets, 2).c_str(), F(row.touched, 1).c_str(), F(cells / ins, 1).c_str(),
       F(links / ins, 1).c_str(), F(r.D("peak_kib") / 1024.0, 1).c_str(), F(row.peak_b, 0).c_str(),
-      F(row.alloc_b, 0).c_str(), G(r.D("max_re")).c_str(), G(r.D("min_dih")).c_str(),
+      F(row.alloc_b, 0).c_str(), F(row.heap_b, 0).c_str(), G(r.D("max_re")).c_str(), G(r.D("min_dih")).c_str(),
       r.kv.count("verify") ? r.kv.at("verify").c_str() : "-");
   std::fflush(stdout);
   return row;
@@ -396,6 +450,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
       {"cells+links/insertion", [](const Row& r) { return r.touched; }},
       {"peak B/tet", [](const Row& r) { return r.peak_b; }},
       {"(peak − start) B/tet", [](const Row& r) { return r.alloc_b; }},
+      {"peak heap B/tet", [](const Row& r) { return r.heap_b; }},
   };
   bool first = true;
   for (const Measure& m : measures) {

@@ -16,6 +16,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/geometry/predicates.h"
+#include "core/util/grow.h"
 
 namespace svrc::delaunay {
 namespace {
@@ -84,8 +85,8 @@ void Delaunay3::GrowTets() {
   const uint32_t old_cap = TetCapacity();
   const uint32_t add = std::max<uint32_t>(64, old_cap / 4);
   const size_t cap = size_t{old_cap} + add;
-  tets_.resize(8 * cap, kFreeSlot);
-  tet_gen_.resize(cap, 0);
+  util::GrowExactly(tets_, 8 * cap, kFreeSlot);
+  util::GrowExactly(tet_gen_, cap, 0u);
   tet_bits_.resize(cap / 64 + 1, 0);
   outside_bits_.resize(cap / 64 + 1, 0);
   for (uint32_t t = static_cast<uint32_t>(cap); t-- > old_cap;) {
@@ -666,7 +667,7 @@ void Delaunay3::set_cache_neighbors(bool on) {
 // many again: copying is amortised over at least live/2 appends, and the pool
 // never holds more than ~1.5× the live lists (~3× while being rebuilt).
 void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
-  if (adj_.size() <= v) adj_.resize(points_.size() + points_.size() / 2 + 16);
+  if (adj_.size() <= v) util::GrowExactly(adj_, points_.size() + points_.size() / 2 + 16);
   if (adj_pool_.size() + m > adj_pool_.capacity()) {
     std::vector<VertexId> pool;
     pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);

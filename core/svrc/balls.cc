@@ -2,6 +2,7 @@
 #include "core/svrc/balls.h"
 
 #include <cmath>
+#include "core/util/grow.h"
 
 namespace svrc::refine {
 
@@ -41,6 +42,8 @@ BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureI
   r.alive = 1;
   r.kind = kind;
   r.encroach_queued = 0;
+  util::ReserveForAppend(rec_);
+  util::ReserveForAppend(mesh_);
   rec_.push_back(r);
   mesh_.push_back(mesh);
   ++num_alive_;

@@ -6,6 +6,7 @@
 
 #include "core/geometry/predicates.h"
 #include "core/svrc/balls.h"
+#include "core/util/grow.h"
 
 namespace svrc::refine {
 
@@ -52,7 +53,7 @@ bool OmegaMesh::InsideCube(const Vec3& p) const {
 
 const OmegaMesh::CcEntry& OmegaMesh::CachedCircumcenter(TetId t) const {
   const uint32_t i = t.value();
-  if (cc_.size() <= i) cc_.resize(dt_.TetCapacity() + 64);
+  if (cc_.size() <= i) util::GrowExactly(cc_, dt_.TetCapacity() + 64);
   const uint32_t g = dt_.Generation(t) + 1;
   CcEntry& e = cc_[i];
   if (e.gen != g) {
@@ -135,7 +136,7 @@ CellSize OmegaMesh::Size(VertexId v) const {
   }
   Uniqueness unique;
   const CellSize out = ComputeSize(v, &unique);
-  if (size_memo_.size() <= v.value()) size_memo_.resize(dt_.NumVertices() + dt_.NumVertices() / 2 + 16);
+  if (size_memo_.size() <= v.value()) util::GrowExactly(size_memo_, dt_.NumVertices() + dt_.NumVertices() / 2 + 16);
   size_memo_[v.value()] = {key, out, out.hint.valid() ? dt_.Generation(out.hint) : 0,
                            out.kept_hint.valid() ? dt_.Generation(out.kept_hint) : 0, unique};
   return out;

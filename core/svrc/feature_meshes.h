@@ -48,8 +48,8 @@ struct CellSize {
 // live tet) or gen == Generation (a tet just freed by an insertion).
 struct TetLabel {
   uint32_t gen = 0;
+  bool kept = false;  // next to gen: 24 bytes, not 32 (one per tet slot)
   double target = HUGE_VAL;
-  bool kept = false;
   // Its region's max_volume in normalised coordinates (+inf: none); read by
   // the per-tet volume test (RefineOptions::tet_volumes).
   double volume = HUGE_VAL;

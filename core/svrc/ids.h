@@ -16,14 +16,12 @@ using PointId = Id<struct PointIdTag>;      // a point of the PLC or a Steiner p
 using BallId = Id<struct BallIdTag>;        // a protective ball (ConfBall / RepBall)
 using MeshId = Id<struct MeshIdTag>;        // a feature mesh M_F (M_Ω is mesh 0)
 using FeatureId = Id<struct FeatureIdTag>;  // a feature of the PLC (vertex, segment, facet) or Ω
-using LinkId = Id<struct LinkIdTag>;        // one BLG link record
 using EventId = Id<struct EventIdTag>;      // one queued work event
 
 inline constexpr PointId kNonePoint{};
 inline constexpr BallId kNoneBall{};
 inline constexpr MeshId kNoneMesh{};
 inline constexpr FeatureId kNoneFeature{};
-inline constexpr LinkId kNoneLink{};
 inline constexpr EventId kNoneEvent{};
 
 // M_Ω is always mesh 0; its feature is Ω itself.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include "core/util/grow.h"
 
 namespace svrc::refine {
 
@@ -24,6 +25,7 @@ void LocationGraph::Arena<Entry>::Append(Span& s, const Entry& e) {
       from.pop_back();
     } else {
       offset = static_cast<uint32_t>(pool_.size());
+      util::ReserveForAppend(pool_, cap);
       pool_.resize(pool_.size() + cap);
     }
     if (s.size > 0) std::memcpy(pool_.data() + offset, pool_.data() + s.offset, s.size * sizeof(Entry));
@@ -48,26 +50,94 @@ void LocationGraph::Arena<Entry>::Release(Span& s) {
   s = Span{};
 }
 
-inline LocationGraph::Span& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
+template <typename Entry>
+bool LocationGraph::Arena<Entry>::WouldGrow(const Span& s) const {
+  if (s.size < s.cap) return false;
+  const uint32_t cap = s.cap == 0 ? kMinCap : 2 * s.cap;
+  return free_[std::countr_zero(cap)].empty() && pool_.size() + cap > pool_.capacity();
+}
+
+template <typename Entry>
+void LocationGraph::Arena<Entry>::Compact(const std::vector<Span*>& spans) {
+  // Blocks only move down (sorted by offset, each packed block no larger than
+  // the one it leaves), so one forward pass of memmoves packs them in place.
+  uint32_t next = 0;
+  for (Span* s : spans) {
+    if (s->size == 0) {
+      s->offset = 0;
+      s->cap = 0;
+      continue;
+    }
+    const uint32_t cap = std::max(kMinCap, std::bit_ceil(s->size));
+    if (s->offset != next) std::memmove(pool_.data() + next, pool_.data() + s->offset, s->size * sizeof(Entry));
+    s->offset = next;
+    s->cap = cap;
+    next += cap;
+  }
+  pool_.resize(next);
+  for (auto& f : free_) f.clear();
+}
+
+namespace {
+// The packed size of arrays of these sizes (Arena::Compact's blocks).
+uint64_t PackedSize(uint32_t size) { return size == 0 ? 0 : std::max(kMinCap, std::bit_ceil(size)); }
+}  // namespace
+
+void LocationGraph::MaybeCompactCells() {
+  uint64_t total = 0;
+  std::vector<Span*> spans;
+  for (std::vector<CellSpanT>& mesh_spans : cell_spans_) {
+    for (CellSpanT& s : mesh_spans) {
+      if (s.cap == 0) continue;
+      total += PackedSize(s.size);
+      spans.push_back(&s);
+    }
+  }
+  if (3 * total > 2 * cell_arena_.PoolSize()) return;
+  std::sort(spans.begin(), spans.end(), [](const Span* a, const Span* b) { return a->offset < b->offset; });
+  cell_arena_.Compact(spans);
+  ++stats_.compactions;
+}
+
+void LocationGraph::MaybeCompactObjects() {
+  uint64_t total = 0;
+  std::vector<Span*> spans;
+  for (std::vector<Span>* list : {&ball_spans_, &collar_spans_}) {
+    for (Span& s : *list) {
+      if (s.cap == 0) continue;
+      total += PackedSize(s.size);
+      spans.push_back(&s);
+    }
+  }
+  if (3 * total > 2 * object_arena_.PoolSize()) return;
+  std::sort(spans.begin(), spans.end(), [](const Span* a, const Span* b) { return a->offset < b->offset; });
+  object_arena_.Compact(spans);
+  ++stats_.compactions;
+}
+
+inline LocationGraph::CellSpanT& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {
   if (mesh.value() < cell_spans_.size() && cell < cell_spans_[mesh.value()].size()) [[likely]] {
     return cell_spans_[mesh.value()][cell];
   }
   if (cell_spans_.size() <= mesh.value()) cell_spans_.resize(mesh.value() + 1);
-  std::vector<Span>& spans = cell_spans_[mesh.value()];
-  if (spans.size() <= cell) spans.resize(cell + 1);
+  std::vector<CellSpanT>& spans = cell_spans_[mesh.value()];
+  if (spans.size() <= cell) {
+    util::ReserveForAppend(spans, cell + 1 - spans.size());
+    spans.resize(cell + 1);
+  }
   return spans[cell];
 }
 
 // The cell's unresolved count went 0 -> 1 / 1 -> 0: it joins / leaves its
 // mesh's list of unresolved cells (swap with the last on removal).
-void LocationGraph::EnterUnresolved(MeshId mesh, uint32_t cell, Span& cs) {
+void LocationGraph::EnterUnresolved(MeshId mesh, uint32_t cell, CellSpanT& cs) {
   if (unresolved_cells_.size() <= mesh.value()) unresolved_cells_.resize(mesh.value() + 1);
   std::vector<uint32_t>& list = unresolved_cells_[mesh.value()];
   cs.upos = static_cast<uint32_t>(list.size());
   list.push_back(cell);
 }
 
-void LocationGraph::LeaveUnresolved(MeshId mesh, Span& cs) {
+void LocationGraph::LeaveUnresolved(MeshId mesh, CellSpanT& cs) {
   std::vector<uint32_t>& list = unresolved_cells_[mesh.value()];
   const uint32_t last = list.back();
   list[cs.upos] = last;
@@ -77,7 +147,10 @@ void LocationGraph::LeaveUnresolved(MeshId mesh, Span& cs) {
 
 inline LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
   std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
-  if (spans.size() <= object.id) [[unlikely]] spans.resize(object.id + 1);
+  if (spans.size() <= object.id) [[unlikely]] {
+    util::ReserveForAppend(spans, object.id + 1 - spans.size());
+    spans.resize(object.id + 1);
+  }
   return spans[object.id];
 }
 
@@ -106,16 +179,11 @@ bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) 
   // Scan the shorter of the two arrays: early in a run one cell can hold
   // thousands of unresolved points, and an input object can be linked to many
   // cells; the other array is then short (bounded ply, Lemma 6).
-  const Span* cs = FindCellSpan(mesh, cell);
+  const CellSpanT* cs = FindCellSpan(mesh, cell);
   const Span* os = FindObjectSpan(object);
   if (cs == nullptr || os == nullptr || cs->size == 0 || os->size == 0) return false;
   if (cs->size <= os->size) return CellPos(*cs, object) != kNil;
   return ObjectPos(*os, mesh, cell) != kNil;
-}
-
-inline uint32_t LocationGraph::NewLinkId() {
-  if (next_link_ == LinkId::kNoneValue) [[unlikely]] next_link_ = 0;
-  return next_link_++;
 }
 
 AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject object,
@@ -123,19 +191,20 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   AddLinkResult result;
   // One lookup per side (the spans are created here if new; an empty span
   // is no link). The duplicate test scans the shorter array, as IsLinked.
-  Span& cs = CellSpan(mesh, cell);
+  CellSpanT& cs = CellSpan(mesh, cell);
   Span& os = ObjectSpan(object);
   if (cs.size != 0 && os.size != 0 &&
       (cs.size <= os.size ? CellPos(cs, object) : ObjectPos(os, mesh, cell)) != kNil) {
     ++stats_.duplicates_refused;
     return result;
   }
-  const uint32_t l = NewLinkId();
-  cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved, l});
+  if (cell_arena_.WouldGrow(cs)) [[unlikely]] MaybeCompactCells();
+  if (object_arena_.WouldGrow(os)) [[unlikely]] MaybeCompactObjects();
+  cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved});
   object_arena_.Append(os, ObjectEntry{mesh.value(), cell});
   ++num_links_;
   ++stats_.links_added;
-  result.link = LinkId(l);
+  result.added = true;
 
   if (facts.unresolved) {
     result.cell_became_unresolved = (cs.unresolved == 0);
@@ -153,7 +222,7 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   return result;
 }
 
-void LocationGraph::RemoveAt(MeshId mesh, Span& cs, uint32_t ci, Span& os, uint32_t oi) {
+void LocationGraph::RemoveAt(MeshId mesh, CellSpanT& cs, uint32_t ci, Span& os, uint32_t oi) {
   if (cell_arena_.Data(cs)[ci].unresolved && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
   cell_arena_.Erase(cs, ci);
   object_arena_.Erase(os, oi);
@@ -161,25 +230,8 @@ void LocationGraph::RemoveAt(MeshId mesh, Span& cs, uint32_t ci, Span& os, uint3
   ++stats_.links_removed;
 }
 
-void LocationGraph::RemoveLink(LinkId id) {
-  if (!id.valid()) return;
-  for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
-    for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
-      Span& cs = cell_spans_[m][c];
-      const CellEntry* e = cell_arena_.Data(cs);
-      for (uint32_t i = 0; i < cs.size; ++i) {
-        if (e[i].link != id.value()) continue;
-        const LocationObject object = e[i].object();
-        Span& os = ObjectSpan(object);
-        RemoveAt(MeshId(m), cs, i, os, ObjectPos(os, MeshId(m), c));
-        return;
-      }
-    }
-  }
-}
-
 bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object) {
-  const Span* cs = FindCellSpan(mesh, cell);
+  const CellSpanT* cs = FindCellSpan(mesh, cell);
   const Span* os = FindObjectSpan(object);
   if (cs == nullptr || os == nullptr) return false;
   const uint32_t oi = ObjectPos(*os, mesh, cell);
@@ -191,7 +243,7 @@ bool LocationGraph::RemoveLink(MeshId mesh, uint32_t cell, LocationObject object
 
 void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<LocationObject>* removed) {
   if (FindCellSpan(mesh, cell) == nullptr) return;
-  Span& cs = cell_spans_[mesh.value()][cell];
+  CellSpanT& cs = cell_spans_[mesh.value()][cell];
   // Front to back, as RemoveLink of each in turn would; the cell's array is
   // emptied at the end instead of shifting it once per link.
   const CellEntry* e = cell_arena_.Data(cs);
@@ -210,7 +262,7 @@ void LocationGraph::RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<Loca
 
 void LocationGraph::RemoveCellLinksWhere(MeshId mesh, uint32_t cell, const std::vector<uint8_t>& drop) {
   if (FindCellSpan(mesh, cell) == nullptr) return;
-  Span& cs = cell_spans_[mesh.value()][cell];
+  CellSpanT& cs = cell_spans_[mesh.value()][cell];
   CellEntry* e = cell_arena_.Data(cs);
   const uint32_t n = std::min<uint32_t>(cs.size, static_cast<uint32_t>(drop.size()));
   uint32_t kept = 0;
@@ -243,7 +295,7 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
       continue;
     }
     if (cells != nullptr) cells->push_back(oe.cell);
-    Span& cs = cell_spans_[oe.mesh][oe.cell];
+    CellSpanT& cs = cell_spans_[oe.mesh][oe.cell];
     const uint32_t ci = CellPos(cs, object);
     if (cell_arena_.Data(cs)[ci].unresolved && --cs.unresolved == 0) LeaveUnresolved(MeshId(oe.mesh), cs);
     cell_arena_.Erase(cs, ci);
@@ -255,7 +307,7 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
 }
 
 void LocationGraph::BallsOf(MeshId mesh, uint32_t cell, std::vector<BallId>* out) const {
-  const Span* cs = FindCellSpan(mesh, cell);
+  const CellSpanT* cs = FindCellSpan(mesh, cell);
   if (cs == nullptr) return;
   const CellEntry* e = cell_arena_.Data(*cs);
   for (uint32_t i = 0; i < cs->size; ++i) {
@@ -264,7 +316,7 @@ void LocationGraph::BallsOf(MeshId mesh, uint32_t cell, std::vector<BallId>* out
 }
 
 void LocationGraph::ObjectsOf(MeshId mesh, uint32_t cell, std::vector<LocationObject>* out) const {
-  const Span* cs = FindCellSpan(mesh, cell);
+  const CellSpanT* cs = FindCellSpan(mesh, cell);
   if (cs == nullptr) return;
   const CellEntry* e = cell_arena_.Data(*cs);
   for (uint32_t i = 0; i < cs->size; ++i) out->push_back(e[i].object());
@@ -280,7 +332,7 @@ void LocationGraph::CellsOf(LocationObject object, MeshId mesh, std::vector<uint
 }
 
 uint32_t LocationGraph::NumUnresolved(MeshId mesh, uint32_t cell) const {
-  const Span* cs = FindCellSpan(mesh, cell);
+  const CellSpanT* cs = FindCellSpan(mesh, cell);
   return cs == nullptr ? 0 : cs->unresolved;
 }
 
@@ -288,19 +340,16 @@ bool LocationGraph::Validate() const {
   // Cell side: each entry must have its partner (mesh, cell) in the object's
   // array. A duplicate object in a cell is caught from the object side.
   uint64_t count = 0;
-  std::vector<uint32_t> ids;
   for (uint32_t m = 0; m < cell_spans_.size(); ++m) {
     uint64_t mesh_total = 0;
     for (uint32_t c = 0; c < cell_spans_[m].size(); ++c) {
-      const Span& cs = cell_spans_[m][c];
+      const CellSpanT& cs = cell_spans_[m][c];
       if (cs.size > cs.cap) return false;
       const CellEntry* e = cell_arena_.Data(cs);
       uint32_t unresolved = 0;
       for (uint32_t i = 0; i < cs.size; ++i) {
         const Span* os = FindObjectSpan(e[i].object());
         if (os == nullptr || ObjectPos(*os, MeshId(m), c) == kNil) return false;
-        if (e[i].link == LinkId::kNoneValue) return false;
-        ids.push_back(e[i].link);
         if (e[i].unresolved) ++unresolved;
         ++count;
       }
@@ -314,7 +363,7 @@ bool LocationGraph::Validate() const {
     if (mesh_total != UnresolvedCells(MeshId(m)).size()) return false;
   }
   // Object side: no (mesh, cell) twice in an object's array, the cell's
-  // array holds the object exactly once; and every link id is distinct.
+  // array holds the object exactly once.
   uint64_t object_count = 0;
   for (int kind = 0; kind < 2; ++kind) {
     const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
@@ -327,7 +376,7 @@ bool LocationGraph::Validate() const {
         for (uint32_t j = 0; j < i; ++j) {
           if (e[j].mesh == e[i].mesh && e[j].cell == e[i].cell) return false;
         }
-        const Span* cs = FindCellSpan(MeshId(e[i].mesh), e[i].cell);
+        const CellSpanT* cs = FindCellSpan(MeshId(e[i].mesh), e[i].cell);
         if (cs == nullptr) return false;
         const CellEntry* ce = cell_arena_.Data(*cs);
         uint32_t found = 0;
@@ -337,8 +386,6 @@ bool LocationGraph::Validate() const {
       }
     }
   }
-  std::sort(ids.begin(), ids.end());
-  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return false;
   return count == num_links_ && object_count == num_links_;
 }
 

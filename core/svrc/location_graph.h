@@ -5,16 +5,16 @@
 // links are added (AddLink) so the refiner can enqueue work events.
 //
 // Representation (guide §2 "BLG"; issue #5): contiguous arrays, not linked
-// lists. Per (mesh, cell) one array of {object, unresolved, link} entries, per
+// lists. Per (mesh, cell) one array of {object, unresolved} entries, per
 // object one array of {mesh, cell} entries (8 bytes: the removal of a cell's
 // links scans its objects' arrays); each array is a block of a shared
 // arena (power-of-two capacities, recycled through per-size free lists). Adds
 // append at the end and removals shift the tail down by one, so iteration
 // order is the order of AddLink calls (deterministic; the refiner's output
-// depends on it). Each link gets a fresh LinkId from a counter, kept in its
-// cell-side entry (no per-link record to write and free: the refiner never
-// removes by LinkId; RemoveLink(LinkId) searches). A query walks one short
-// array (bounded ply, Lemma 6) instead of chasing one pointer per link.
+// depends on it). A link is its (mesh, cell, object) triple: there is no
+// per-link record or id (8 bytes per cell-side entry; the refiner never named
+// a link by anything else). A query walks one short array (bounded ply,
+// Lemma 6) instead of chasing one pointer per link.
 #pragma once
 
 #include <cstdint>
@@ -48,7 +48,7 @@ struct LinkFacts {
 };
 
 struct AddLinkResult {
-  LinkId link;
+  bool added = false;  // false: the link existed (AddLink refuses duplicates)
   EncroachOutcome encroach = EncroachOutcome::kNothing;  // Figure 3.10's trap
   bool cell_became_unresolved = false;  // first unresolved object of this cell
 };
@@ -58,21 +58,16 @@ class LocationGraph {
   // AddLink(v, F, O) of Figure 3.10: adds both directions. For a ball with
   // facts.encroaches, records the encroacher in `balls` and reports whether an
   // Encroached event is due. A duplicate (same object, mesh, cell) is refused
-  // (returns an invalid link): links are sets (Lemma 36 counts unique pairs).
+  // (added = false): links are sets (Lemma 36 counts unique pairs).
   AddLinkResult AddLink(MeshId mesh, uint32_t cell, LocationObject object, const LinkFacts& facts,
                         BallStore* balls);
-  // RemoveLink: deletes both directions. Time linear in the number of cells and links
-  // (tests and debugging; the refiner removes by cell or object). An id
-  // whose link is gone removes nothing (ids are not reused before 2^32 − 1
-  // further links).
-  void RemoveLink(LinkId link);
   // Removes the link (mesh, cell, object) if present; returns whether it was.
   bool RemoveLink(MeshId mesh, uint32_t cell, LocationObject object);
   // Removes every link of a cell, appending the objects to `removed` (in link
   // order) when non-null. Used when a cell changes (UpdateLocation).
   void RemoveCellLinks(MeshId mesh, uint32_t cell, std::vector<LocationObject>* removed);
   // Removes the links of a cell whose entry i (in link order, as ObjectsOf
-  // lists them) has drop[i] != 0; the kept links keep their order and ids.
+  // lists them) has drop[i] != 0; the kept links keep their order.
   // `drop` has one entry per link of the cell. UpdateLocation for a cell that
   // shrank: its surviving links stay in place instead of being removed and
   // added again.
@@ -88,7 +83,7 @@ class LocationGraph {
   // graph.
   template <typename F>
   void ForEachBall(MeshId mesh, uint32_t cell, F&& f) const {
-    const Span* cs = FindCellSpan(mesh, cell);
+    const CellSpanT* cs = FindCellSpan(mesh, cell);
     if (cs == nullptr) return;
     const CellEntry* e = cell_arena_.Data(*cs);
     for (uint32_t i = 0, n = cs->size; i < n; ++i) {
@@ -99,7 +94,7 @@ class LocationGraph {
   // not yet in the mesh), in link order; f as in ForEachBall.
   template <typename F>
   void ForEachUnresolvedBall(MeshId mesh, uint32_t cell, F&& f) const {
-    const Span* cs = FindCellSpan(mesh, cell);
+    const CellSpanT* cs = FindCellSpan(mesh, cell);
     if (cs == nullptr || cs->unresolved == 0) return;
     const CellEntry* e = cell_arena_.Data(*cs);
     for (uint32_t i = 0, n = cs->size; i < n; ++i) {
@@ -115,7 +110,7 @@ class LocationGraph {
   uint32_t NumUnresolved(MeshId mesh, uint32_t cell) const;
   // All links of the cell.
   uint32_t NumCellLinks(MeshId mesh, uint32_t cell) const {
-    const Span* cs = FindCellSpan(mesh, cell);
+    const CellSpanT* cs = FindCellSpan(mesh, cell);
     return cs == nullptr ? 0 : cs->size;
   }
   // The cells of the mesh with an unresolved link, in no particular (but
@@ -138,27 +133,34 @@ class LocationGraph {
     uint64_t links_added = 0;    // LW-events (Lemma 36), add side
     uint64_t links_removed = 0;  // LW-events, remove side
     uint64_t duplicates_refused = 0;
+    uint64_t compactions = 0;  // arenas packed (MaybeCompactCells/Objects)
   };
   const Stats& stats() const { return stats_; }
+  // Entries the two arenas hold (live, in unused block room, or in free
+  // blocks): the graph's storage, for tests of its compaction.
+  uint64_t ArenaEntries() const { return cell_arena_.PoolSize() + object_arena_.PoolSize(); }
 
  private:
   static constexpr uint32_t kNil = 0xFFFFFFFFu;
 
   // One block of an Arena: entries [offset, offset + size), room for `cap`.
-  // A cell's span also counts its unresolved links (next to its size: one
-  // access for both).
   struct Span {
     uint32_t offset = 0;
     uint32_t size = 0;
     uint32_t cap = 0;  // 0: no block yet; otherwise a power of two
-    uint32_t unresolved = 0;  // cell spans only
-    uint32_t upos = 0;        // cell spans with unresolved > 0: position in unresolved_cells_
+  };
+  // A cell's span also counts its unresolved links (next to its size: one
+  // access for both). An object's span is a plain Span (12 bytes per ball).
+  struct CellSpanT : Span {
+    uint32_t unresolved = 0;
+    uint32_t upos = 0;  // unresolved > 0: position in unresolved_cells_
   };
   // Blocks of small arrays in one vector. A full block moves to a block of
   // twice its capacity (taken from that size's free list, else appended); the
   // old block goes to its free list. Blocks of emptied arrays are kept (a cell
   // emptied by UpdateLocation is usually refilled at once) except a dead
-  // object's (RemoveObjectLinks): ball ids are not reused.
+  // object's (RemoveObjectLinks): ball ids are not reused. Blocks of arrays
+  // that shrank stay too, until the arena is packed (MaybeCompactCells).
   template <typename Entry>
   class Arena {
    public:
@@ -170,30 +172,39 @@ class LocationGraph {
     void Erase(Span& s, uint32_t i);
     // Returns the block of an empty array to its free list.
     void Release(Span& s);
+    // Whether Append(s, ·) would have to enlarge the pool's storage: the
+    // array is full, no free block of the next size exists, and the pool has
+    // no room left for one.
+    bool WouldGrow(const Span& s) const;
+    // Packs the blocks of `spans` (every span with a block, sorted by offset)
+    // to the front of the pool, each array keeping its entries in order in a
+    // block of max(kMinCap, bit_ceil(size)) entries (an empty array loses its
+    // block); the free lists are emptied.
+    void Compact(const std::vector<Span*>& spans);
+    uint64_t PoolSize() const { return pool_.size(); }
 
    private:
     std::vector<Entry> pool_;
     std::vector<uint32_t> free_[32];  // [log2 cap] offsets of free blocks
   };
 
-  // The cell side: which object, whether the link counts as unresolved, and
-  // the link's id.
+  // The cell side: which object, and whether the link counts as unresolved.
   struct CellEntry {
     uint32_t object_id = 0;
     ObjectKind kind = ObjectKind::kBall;
     bool unresolved = false;
-    uint32_t link = 0;
     LocationObject object() const { return {kind, object_id}; }
     bool Is(LocationObject o) const { return object_id == o.id && kind == o.kind; }
   };
+  static_assert(sizeof(CellEntry) == 8);
   // The object side: which cell of which mesh.
   struct ObjectEntry {
     uint32_t mesh = 0;
     uint32_t cell = 0;
   };
 
-  Span& CellSpan(MeshId mesh, uint32_t cell);
-  const Span* FindCellSpan(MeshId mesh, uint32_t cell) const {
+  CellSpanT& CellSpan(MeshId mesh, uint32_t cell);
+  const CellSpanT* FindCellSpan(MeshId mesh, uint32_t cell) const {
     if (cell_spans_.size() <= mesh.value() || cell_spans_[mesh.value()].size() <= cell) return nullptr;
     return &cell_spans_[mesh.value()][cell];
   }
@@ -203,18 +214,26 @@ class LocationGraph {
   // object's array; kNil when absent.
   uint32_t CellPos(const Span& cs, LocationObject object) const;
   uint32_t ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const;
-  uint32_t NewLinkId();
   // Removes entry `oi` of the object's array and entry `ci` of the cell's
   // array, which must be the same link.
-  void RemoveAt(MeshId mesh, Span& cs, uint32_t ci, Span& os, uint32_t oi);
-  void EnterUnresolved(MeshId mesh, uint32_t cell, Span& cs);
-  void LeaveUnresolved(MeshId mesh, Span& cs);
+  void RemoveAt(MeshId mesh, CellSpanT& cs, uint32_t ci, Span& os, uint32_t oi);
+  void EnterUnresolved(MeshId mesh, uint32_t cell, CellSpanT& cs);
+  void LeaveUnresolved(MeshId mesh, CellSpanT& cs);
+  // Before an append that would enlarge an arena's storage: when the arrays
+  // would fit, packed, in at most 2/3 of the pool (the rest being blocks of
+  // emptied or shrunk arrays and free blocks), the arena is packed instead
+  // (Arena::Compact; each packing frees a third of the pool, so its linear
+  // cost is amortised over the appends that filled that third).
+  // A cell's array keeps the block of its largest size until then, so without
+  // this the pool kept the high-water mark of every array at once (cube
+  // --max-volume 1e-4: 197k cell-side entries for at most 44k live links).
+  void MaybeCompactCells();
+  void MaybeCompactObjects();
 
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;
-  uint32_t next_link_ = 0;  // the next LinkId (skips kNone)
   uint32_t num_links_ = 0;
-  std::vector<std::vector<Span>> cell_spans_;      // [mesh][cell]
+  std::vector<std::vector<CellSpanT>> cell_spans_;  // [mesh][cell]
   std::vector<std::vector<uint32_t>> unresolved_cells_;  // [mesh]: cells with unresolved > 0
   std::vector<Span> ball_spans_;
   std::vector<Span> collar_spans_;

@@ -32,6 +32,7 @@
 #include "core/svrc/containment.h"
 #include "core/svrc/facet_mesh.h"
 #include "core/svrc/feature_meshes.h"
+#include "core/util/grow.h"
 #include "core/svrc/labelling.h"
 #include "core/svrc/location_graph.h"
 #include "core/svrc/normalize.h"
@@ -1502,7 +1503,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     cert_mark_.resize(nvert + nvert / 2 + 16, 0);
     cert_pos_.resize(cert_mark_.size(), 0);
   }
-  if (cell_cert_.size() < nvert) cell_cert_.resize(nvert + nvert / 2 + 16);
+  if (cell_cert_.size() < nvert) util::GrowExactly(cell_cert_, nvert + nvert / 2 + 16);
   for (size_t i = 0; i + 1 < changed.size(); ++i) {
     cert_mark_[changed[i].value()] = cert_stamp_;
     cert_pos_[changed[i].value()] = static_cast<uint32_t>(i);
@@ -1732,13 +1733,13 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
       created_labels_[k] = tet_labels_[d.value()];
     }
   }
-  if (tet_labels_.size() < dt.TetCapacity()) tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
-  if (size_target_.size() < dt.NumVertices()) size_target_.resize(dt.NumVertices() + dt.NumVertices() / 2 + 16, HUGE_VAL);
+  if (tet_labels_.size() < dt.TetCapacity()) util::GrowExactly(tet_labels_, dt.TetCapacity() + dt.TetCapacity() / 2);
+  if (size_target_.size() < dt.NumVertices()) util::GrowExactly(size_target_, dt.NumVertices() + dt.NumVertices() / 2 + 16, HUGE_VAL);
   for (size_t k = 0; k < n; ++k) {
     const TetId c = inserted.created[k];
     const bool known = created_labels_[k].gen != 0;
     const double target = created_labels_[k].target;
-    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, target, created_labels_[k].kept,
+    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, created_labels_[k].kept, target,
                               created_labels_[k].volume};
     if (!known || target == HUGE_VAL || dt.IsGhost(c) || tet_sizes_) continue;
     for (int i = 0; i < 4; ++i) {
@@ -2815,7 +2816,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
     if (!tet_labels_.empty()) {
-      tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, HUGE_VAL, lab->Kept(static_cast<uint32_t>(t))};
+      tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, lab->Kept(static_cast<uint32_t>(t)), HUGE_VAL};
     }
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     if (tet_volume[t] == HUGE_VAL) continue;

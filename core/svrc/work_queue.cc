@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include "core/util/grow.h"
 
 namespace svrc::refine {
 
@@ -33,11 +34,15 @@ int WorkQueues::BucketOf(double radius) {
   return std::ilogb(radius) - kMinExp;
 }
 
-WorkQueues::WorkQueues() {
-  for (Queue& q : queues_) {
-    q.head.assign(kNumBuckets, kNil);
-    q.tail.assign(kNumBuckets, kNil);
+WorkQueues::WorkQueues() = default;
+
+uint32_t* WorkQueues::Queue::Chunk(int b) {
+  std::unique_ptr<uint32_t[]>& c = chunks[b / kChunk];
+  if (c == nullptr) [[unlikely]] {
+    c = std::make_unique<uint32_t[]>(2 * kChunk);
+    std::fill(c.get(), c.get() + 2 * kChunk, kNil);
   }
+  return c.get();
 }
 
 EventHandle WorkQueues::Enqueue(const WorkEvent& event) {
@@ -55,6 +60,7 @@ EventHandle WorkQueues::Enqueue(const WorkEvent& event) {
     free_head_ = entries_[e].next;
   } else {
     e = static_cast<uint32_t>(entries_.size());
+    util::ReserveForAppend(entries_);
     entries_.emplace_back();
   }
   Entry& entry = entries_[e];
@@ -68,16 +74,19 @@ EventHandle WorkQueues::Enqueue(const WorkEvent& event) {
 void WorkQueues::Link(uint32_t e, int q, int bucket) {
   Entry& entry = entries_[e];
   Queue& queue = queues_[q];
+  uint32_t* chunk = queue.Chunk(bucket);
+  uint32_t& head = chunk[bucket % kChunk];
+  uint32_t& tail = chunk[kChunk + bucket % kChunk];
   entry.queue = static_cast<int16_t>(q);
-  entry.bucket = bucket;
+  entry.bucket = static_cast<int16_t>(bucket);
   entry.next = kNil;
-  entry.prev = queue.tail[bucket];
+  entry.prev = tail;
   if (entry.prev != kNil) {
     entries_[entry.prev].next = e;
   } else {
-    queue.head[bucket] = e;
+    head = e;
   }
-  queue.tail[bucket] = e;
+  tail = e;
   queue.cursor = std::max(queue.cursor, bucket);
   ++queue_size_[q];
   ++size_;
@@ -86,15 +95,16 @@ void WorkQueues::Link(uint32_t e, int q, int bucket) {
 void WorkQueues::Unlink(uint32_t e) {
   Entry& entry = entries_[e];
   Queue& queue = queues_[entry.queue];
+  uint32_t* chunk = queue.chunks[entry.bucket / kChunk].get();  // allocated: the entry is in it
   if (entry.prev != kNil) {
     entries_[entry.prev].next = entry.next;
   } else {
-    queue.head[entry.bucket] = entry.next;
+    chunk[entry.bucket % kChunk] = entry.next;
   }
   if (entry.next != kNil) {
     entries_[entry.next].prev = entry.prev;
   } else {
-    queue.tail[entry.bucket] = entry.prev;
+    chunk[kChunk + entry.bucket % kChunk] = entry.prev;
   }
   --queue_size_[entry.queue];
   --size_;
@@ -120,14 +130,14 @@ uint32_t WorkQueues::PopFrom(int q) {
     return kNil;
   }
   uint64_t walked = 0;
-  while (queue.cursor >= 0 && queue.head[queue.cursor] == kNil) {
+  while (queue.cursor >= 0 && queue.Head(queue.cursor) == kNil) {
     --queue.cursor;
     ++walked;
   }
   stats_.buckets_walked += walked;
   stats_.max_walk_one_op = std::max(stats_.max_walk_one_op, walked);
   assert(queue.cursor >= 0);
-  const uint32_t e = queue.head[queue.cursor];
+  const uint32_t e = queue.Head(queue.cursor);
   Unlink(e);
   return e;
 }
@@ -214,7 +224,7 @@ double WorkQueues::LargestPendingRadius() const {
     if (queue_size_[q] == 0) continue;
     const Queue& queue = queues_[q];
     for (int b = queue.cursor; b >= 0; --b) {
-      if (queue.head[b] != kNil) {
+      if (queue.Head(b) != kNil) {
         best = std::max(best, std::ldexp(1.0, b + kMinExp));
         break;
       }
@@ -230,7 +240,7 @@ bool WorkQueues::Validate() const {
     size_t count = 0;
     for (int b = 0; b < kNumBuckets; ++b) {
       uint32_t prev = kNil;
-      for (uint32_t e = queue.head[b]; e != kNil; e = entries_[e].next) {
+      for (uint32_t e = queue.Head(b); e != kNil; e = entries_[e].next) {
         const Entry& entry = entries_[e];
         if (entry.queue != q || entry.bucket != b || entry.prev != prev) return false;
         if (BucketOf(entry.event.radius) != b) return false;
@@ -238,7 +248,7 @@ bool WorkQueues::Validate() const {
         prev = e;
         ++count;
       }
-      if (queue.tail[b] != prev) return false;
+      if (queue.Tail(b) != prev) return false;
     }
     if (count != queue_size_[q]) return false;
     total += count;

@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -135,11 +136,28 @@ class WorkQueues {
     uint32_t prev = kNil, next = kNil;
     uint32_t generation = 0;
     int16_t queue = -1;  // -1: free slot
-    int32_t bucket = 0;
+    int16_t bucket = 0;  // BucketOf's range [-1075, 1023]
   };
+  static_assert(sizeof(Entry) == 64);  // one cache line per queued event
+  // A queue's buckets come in chunks of 64, allocated when an event first
+  // lands in one (a run touches a few dozen of the 2099 buckets; allocating
+  // them all for twelve queues was 200 KB per job).
+  static constexpr int kChunk = 64;
+  static constexpr int kNumChunks = (kNumBuckets + kChunk - 1) / kChunk;
   struct Queue {
-    std::vector<uint32_t> head, tail;  // per bucket
-    int cursor = -1;                   // no non-empty bucket above it
+    // Per chunk: heads of its buckets in [0, kChunk), tails in [kChunk, 2·kChunk).
+    std::array<std::unique_ptr<uint32_t[]>, kNumChunks> chunks;
+    int cursor = -1;  // no non-empty bucket above it
+    uint32_t Head(int b) const {
+      const uint32_t* c = chunks[b / kChunk].get();
+      return c == nullptr ? kNil : c[b % kChunk];
+    }
+    uint32_t Tail(int b) const {
+      const uint32_t* c = chunks[b / kChunk].get();
+      return c == nullptr ? kNil : c[kChunk + b % kChunk];
+    }
+    // The chunk of bucket b, allocated (all kNil) if new.
+    uint32_t* Chunk(int b);
   };
 
   void Link(uint32_t e, int queue, int bucket);
