@@ -56,16 +56,14 @@ struct Quality {
   double max_dihedral = 0;
   double radius_edge = 0;
   double volume = 0;  // unsigned, floating point
+  // False: the dihedral fields are not computed yet, and the tet is known to
+  // have every dihedral angle strictly between the target and 180° − target
+  // (FlipMesh::Init's volume test; FlipMesh::Dihedrals fills them on demand).
+  bool dihedrals = true;
 };
 
 void MeasureBounds(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, SliverTetQuality* out);
 void MeasureDihedrals(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, SliverTetQuality* out);
-
-Quality Measure(std::span<const Vec3> pos, Tet t) {
-  std::sort(t.begin(), t.end());
-  const SliverTetQuality q = MeasureSliverTet(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]]);
-  return Quality{q.min_dihedral_deg, q.max_dihedral_deg, q.radius_edge, q.volume};
-}
 
 // Measure in two halves for flip candidates: the bounds (radius-edge,
 // volume; dihedral fields left 0), then, once every new tet of the flip has
@@ -83,6 +81,42 @@ void FillDihedrals(std::span<const Vec3> pos, Tet t, Quality* out) {
   MeasureDihedrals(pos[t[0]], pos[t[1]], pos[t[2]], pos[t[3]], &q);
   out->min_dihedral = q.min_dihedral_deg;
   out->max_dihedral = q.max_dihedral_deg;
+  out->dihedrals = true;
+}
+
+// An input tet's quality, its dihedral angles left for later when its volume
+// alone shows them all in (target, 180° − target): a dihedral θ at edge e
+// between faces of areas A1, A2 gives 6|V| = 4·A1·A2·sin θ / |e| ≤ ℓ³ sin θ
+// (each face's height over e is at most the longest edge ℓ), so
+// 6|V| > ℓ³ · sin_target implies sin θ > sin(target) for all six. The factor
+// 1 + 1e-6 keeps the rounding of |V| and ℓ³ (~1e-15 relative) on the safe
+// side, far beyond the error of the angles themselves: a tet skipped here
+// would have measured strictly above the target. On cube --max-volume 1e-5
+// most input tets pass; the angles were 3% of the run's instructions.
+Quality MeasureInput(std::span<const Vec3> pos, Tet t, double sin_target) {
+  std::sort(t.begin(), t.end());
+  SliverTetQuality q;
+  const Vec3& a = pos[t[0]];
+  const Vec3& b = pos[t[1]];
+  const Vec3& c = pos[t[2]];
+  const Vec3& d = pos[t[3]];
+  MeasureBounds(a, b, c, d, &q);
+  Quality out{0, 0, q.radius_edge, q.volume};
+  if (sin_target > 0) {
+    const Vec3 p[4] = {a, b, c, d};
+    double longest2 = 0;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) longest2 = std::max(longest2, geom::Dist2(p[i], p[j]));
+    }
+    if (6 * q.volume > longest2 * std::sqrt(longest2) * sin_target * (1 + 1e-6)) {
+      out.dihedrals = false;
+      return out;
+    }
+  }
+  MeasureDihedrals(a, b, c, d, &q);
+  out.min_dihedral = q.min_dihedral_deg;
+  out.max_dihedral = q.max_dihedral_deg;
+  return out;
 }
 
 // Edge removal (Shewchuk, "Two discrete optimization algorithms for the
@@ -200,13 +234,19 @@ class FlipMesh {
   // which t has an improving flip. The best sequence (largest worst new
   // quality) goes to `seq`; the mesh is left as it was.
   bool Search(uint32_t t, int depth, double floor, std::vector<Flip>* seq, double* score);
+  // quality_[t] with its dihedral angles (computed now if Init left them).
+  const Quality& Dihedrals(uint32_t t) const {
+    Quality& q = quality_[t];
+    if (!q.dihedrals) FillDihedrals(pos_, tet_[t], &q);
+    return q;
+  }
 
   std::span<const Vec3> pos_;
   const SliverOptions& options_;
   SliverStats* stats_;
   std::vector<Tet> tet_;
   std::vector<std::array<uint32_t, 4>> nbr_;
-  std::vector<Quality> quality_;
+  mutable std::vector<Quality> quality_;  // dihedrals filled on demand (Dihedrals)
   std::vector<uint32_t> version_;
   std::vector<uint8_t> alive_;
   std::vector<uint32_t> component_;            // per slot
@@ -251,6 +291,9 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   nbr_.assign(num_tets, {kNone, kNone, kNone, kNone});
   quality_.resize(num_tets);
   version_.assign(num_tets, 0);
+  // Lazy angles need 0 < target < 90° (sin is increasing there).
+  const double target = options_.target_min_dihedral_deg;
+  const double sin_target = target > 0 && target < 90 ? std::sin(target * (3.14159265358979323846 / 180)) : 0;
   alive_.assign(num_tets, 1);
   for (size_t t = 0; t < num_tets; ++t) {
     const Tet& v = tet_[t];
@@ -269,7 +312,7 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
     if (geom::Orient3d(pos_[v[0]], pos_[v[1]], pos_[v[2]], pos_[v[3]]) < 0) {
       return absl::InvalidArgumentError(absl::StrCat("sliver: tet ", t, " is negatively oriented"));
     }
-    quality_[t] = Measure(pos_, v);
+    quality_[t] = MeasureInput(pos_, v, sin_target);
   }
   // Adjacency: the 4T faces grouped by their vertex sets, as LabelRegions
   // does (tet_faces.h: no hashing, no sort of all 4T records, which took ~5%
@@ -437,6 +480,7 @@ void FlipMesh::Undo(const Journal& journal) {
 void FlipMesh::Push(uint32_t t) {
   // An input tet outside the output (never replaced: version 0) is skipped.
   if (t < options_.skip_tet.size() && options_.skip_tet[t] != 0 && version_[t] == 0) return;
+  if (!quality_[t].dihedrals) return;  // every angle above the target
   if (quality_[t].min_dihedral < options_.target_min_dihedral_deg) {
     queue_.emplace(quality_[t].min_dihedral, t, version_[t]);
   }
@@ -522,7 +566,7 @@ bool FlipMesh::Build23(uint32_t t, int f, Flip* flip) {
   flip->old_tets[0] = t;
   flip->old_tets[1] = n;
   flip->num_old = 2;
-  flip->old_min = std::min(quality_[t].min_dihedral, quality_[n].min_dihedral);
+  flip->old_min = std::min(Dihedrals(t).min_dihedral, Dihedrals(n).min_dihedral);
   const double re_bound =
       std::max(options_.max_radius_edge, std::max(quality_[t].radius_edge, quality_[n].radius_edge));
   const double volume_bound = component_max_volume_[component_[t]];
@@ -563,7 +607,7 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
   }
   double old_min = kInf, re_bound = options_.max_radius_edge;
   for (int k = 0; k < n; ++k) {
-    old_min = std::min(old_min, quality_[ring_tets[k]].min_dihedral);
+    old_min = std::min(old_min, Dihedrals(ring_tets[k]).min_dihedral);
     re_bound = std::max(re_bound, quality_[ring_tets[k]].radius_edge);
   }
   const double volume_bound = component_max_volume_[component_[t]];
@@ -673,7 +717,7 @@ bool FlipMesh::TouchesCrease(const Tet& t) const {
 bool FlipMesh::RaisesCreaseAngle(const Flip& f) const {
   if (options_.crease_vertex.empty()) return false;
   double old_max = 0;
-  for (int i = 0; i < f.num_old; ++i) old_max = std::max(old_max, quality_[f.old_tets[i]].max_dihedral);
+  for (int i = 0; i < f.num_old; ++i) old_max = std::max(old_max, Dihedrals(f.old_tets[i]).max_dihedral);
   for (int i = 0; i < f.num_new; ++i) {
     if (f.new_quality[i].max_dihedral > old_max && TouchesCrease(f.new_tets[i])) return true;
   }
@@ -865,7 +909,7 @@ void FlipMesh::Run() {
         std::vector<Flip> seq;
         double score = -kInf;
         if (options_.lookahead_depth < 2 || !(quality_[t].radius_edge <= options_.max_radius_edge) ||
-            !Search(t, static_cast<int>(options_.lookahead_depth), quality_[t].min_dihedral, &seq, &score)) {
+            !Search(t, static_cast<int>(options_.lookahead_depth), Dihedrals(t).min_dihedral, &seq, &score)) {
           ++stats_->stuck;
           continue;
         }
@@ -892,14 +936,30 @@ void FlipMesh::Run() {
 void FlipMesh::Summarize(bool before) {
   uint64_t count = 0, bad = 0;
   double min_dih = kInf, max_dih = 0, max_re = 0;
+  bool lazy = false;
   for (size_t t = 0; t < tet_.size(); ++t) {
     if (!alive_[t]) continue;
     const Quality& q = quality_[t];
     ++count;
+    max_re = std::max(max_re, q.radius_edge);
+    if (!q.dihedrals) {
+      lazy = true;  // not bad; its angles lie in (target, 180° − target)
+      continue;
+    }
     bad += q.min_dihedral < options_.target_min_dihedral_deg;
     min_dih = std::min(min_dih, q.min_dihedral);
     max_dih = std::max(max_dih, q.max_dihedral);
-    max_re = std::max(max_re, q.radius_edge);
+  }
+  // The skipped tets decide the extremes only when no measured tet reaches
+  // below the target / above 180° − target: then they are measured too.
+  const double target = options_.target_min_dihedral_deg;
+  if (lazy && (!(min_dih < target) || !(max_dih >= 180 - target))) {
+    for (size_t t = 0; t < tet_.size(); ++t) {
+      if (!alive_[t] || quality_[t].dihedrals) continue;
+      const Quality& q = Dihedrals(static_cast<uint32_t>(t));
+      min_dih = std::min(min_dih, q.min_dihedral);
+      max_dih = std::max(max_dih, q.max_dihedral);
+    }
   }
   if (count == 0) min_dih = 0;
   if (before) {
