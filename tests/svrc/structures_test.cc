@@ -562,9 +562,22 @@ TEST(LocationGraphTest, CompactsArraysThatShrank) {
         if (l.live && l.object == o) l.live = false;
       }
     }
+    // Every array in order, both sides (ExpectSameAsModel's IsLinked sweep
+    // over all cell × ball pairs is too slow here under the sanitizers).
     ASSERT_TRUE(g.Validate()) << "round " << round;
-    ASSERT_NO_FATAL_FAILURE(
-        ExpectSameAsModel(g, model, kMeshes, first + kCellsPerRound, kBalls, 0, static_cast<int>(round)));
+    ASSERT_EQ(g.NumLinks(), model.NumLive());
+    for (uint32_t c = 0; c < first + kCellsPerRound; ++c) {
+      std::vector<LocationObject> got;
+      g.ObjectsOf(MeshId(c % kMeshes), c, &got);
+      ASSERT_EQ(got, model.Objects(MeshId(c % kMeshes), c)) << "cell " << c << " round " << round;
+    }
+    for (uint32_t b = 0; b < kBalls; ++b) {
+      for (int m = 0; m < kMeshes; ++m) {
+        std::vector<uint32_t> got;
+        g.CellsOf(LocationObject::Ball(BallId(b)), MeshId(m), &got);
+        ASSERT_EQ(got, model.Cells(LocationObject::Ball(BallId(b)), MeshId(m))) << "ball " << b << " round " << round;
+      }
+    }
   }
   EXPECT_GT(g.stats().compactions, 0u);
   // Packed blocks are ≤ 2× their arrays and the pool is at most 1.5× its
