@@ -80,10 +80,6 @@ double Jitter(uint64_t id, uint64_t salt) {
   return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
 }
 constexpr double kJitter = 1e-6;
-// DestroyOmegaAt gathers balls from v and the cells holding unresolved
-// 0-balls instead of searching the cells meeting B when there are at most this
-// many such cells.
-constexpr size_t kLocalDestroyCells = 64;
 
 Vec2 Mid2(Vec2 a, Vec2 b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}; }
 double HalfLen2(Vec2 a, Vec2 b) { return 0.5 * std::hypot(a.x - b.x, a.y - b.y); }
@@ -1368,7 +1364,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     // the CPU of cube.poly --max-volume 1e-5 before session 9; the output is
     // byte-identical).
     const std::vector<uint32_t>& unresolved_cells = blg_.UnresolvedCells(kOmegaMesh);
-    if (unresolved_cells.size() <= kLocalDestroyCells) {
+    if (unresolved_cells.size() <= options_.local_destroy_cells) {
       bfs_.assign(1, v);
       for (uint32_t u : unresolved_cells) {
         if (u != v.value()) bfs_.push_back(VertexId(u));

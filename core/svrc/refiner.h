@@ -70,6 +70,12 @@ struct RefineOptions {
   // line 3) instead of v's balls and the other cells' unresolved 0-balls
   // only (the same choices: docs/svrc-design.md §8 item 36). Tests.
   bool destroy_gather_all = false;
+  // Destroy in M_Ω gathers from v and the cells holding unresolved 0-balls,
+  // without searching the cells meeting B, when at most this many cells hold
+  // them (the same choices either way: a warp target within θr of c lies in a
+  // cell meeting B). docs/svrc-design.md §8 item 40; 0 searches whenever any
+  // cell holds one (tests).
+  uint32_t local_destroy_cells = 256;
   // UpdateLocation drops a shrunk cell's link to a lower ball that lies
   // wholly beyond the bisector of the cell's vertex and the new point, and
   // links the new cell's balls in ball-id order (docs/svrc-design.md §8 item
@@ -225,7 +231,7 @@ struct RefineStats {
   std::array<uint64_t, 4> events_stale{};
   uint64_t destroy_cells_visited = 0;  // |𝒱| summed over Destroy calls
   uint64_t destroy_balls_read = 0;     // balls Destroy in M_Ω tested for a warp or a yield
-  uint64_t destroys_local = 0;     // Destroy in M_Ω with no unresolved 0-ball: 𝒱 = {v}
+  uint64_t destroys_local = 0;     // Destroy in M_Ω without the search of cells meeting B (local_destroy_cells)
   uint64_t max_destroy_cells = 0;
   uint64_t buckets_walked = 0;
   uint64_t max_bucket_walk = 0;

@@ -415,6 +415,27 @@ TEST(CollarRefine, DestroyReadsWhatItNeedsWithTheSameRefinement) {
   }
 }
 
+// Destroy without the search of the cells meeting B when at most
+// RefineOptions::local_destroy_cells cells hold unresolved 0-balls (§8 item
+// 40): a warp target within θr of c lies in a cell meeting B, and v's own
+// balls hold every yield, so gathering from v and all unresolved cells makes
+// the same choices. Bit-identical refinements against the search on every
+// Destroy (0), with more local Destroys at the default.
+TEST(CollarRefine, LocalDestroyMakesTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"c_creases/knife_edge.poly", true, 0}, SameRefinementCase{"a_convex/cube.poly", false, 1e-4},
+        SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
+        SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 0}}) {
+    if (kSanitized && c.collars) continue;
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->local_destroy_cells = on ? 256 : 0; });
+    EXPECT_EQ(runs[0].stats.warps, runs[1].stats.warps) << c.rel;
+    EXPECT_EQ(runs[0].stats.yields, runs[1].stats.yields) << c.rel;
+    EXPECT_GT(runs[1].stats.destroys_local, runs[0].stats.destroys_local) << c.rel;
+    std::printf("%s: %llu of the Destroys local, %llu with the search whenever a cell holds an unresolved point\n",
+                c.rel, (unsigned long long)runs[1].stats.destroys_local, (unsigned long long)runs[0].stats.destroys_local);
+  }
+}
+
 // The corpus file `file`, or families::NestedBoxes(3, 1e-2, 1/8) (three
 // regions with max volumes 1e-2, 1.25e-3, 1.5625e-4) for "nested".
 absl::StatusOr<plc::Plc> CaseInput(const std::string& file) {
