@@ -1,35 +1,48 @@
 #include "core/mesh/canonical.h"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
-#include <numeric>
 
 namespace svrc::mesh {
 namespace {
 
 constexpr int kHilbertBits = 21;
 
-// Sorts the index permutation of `items` by (item, tag), where tags may be
-// empty, then applies it to both.
-template <typename T>
-void SortCarrying(std::vector<T>* items, std::vector<int32_t>* tags) {
+// Sorts `items` (arrays of N vertex ids) by (item, tag, original position),
+// tags may be empty, and applies the order to both. The records are sorted
+// themselves, their ids packed two to a 64-bit word, rather than an index
+// permutation through a comparator that reads the arrays (two cache misses
+// per comparison: 2.8% of cube --max-volume 1e-5's instructions).
+template <size_t N>
+void SortCarrying(std::vector<std::array<uint32_t, N>>* items, std::vector<int32_t>* tags) {
+  static_assert(N == 3 || N == 4);
   const size_t n = items->size();
   const bool has_tags = tags->size() == n;
-  std::vector<uint32_t> perm(n);
-  std::iota(perm.begin(), perm.end(), 0u);
-  std::sort(perm.begin(), perm.end(), [&](uint32_t i, uint32_t j) {
-    if ((*items)[i] != (*items)[j]) return (*items)[i] < (*items)[j];
-    if (has_tags && (*tags)[i] != (*tags)[j]) return (*tags)[i] < (*tags)[j];
-    return i < j;
+  struct Record {
+    uint64_t hi, lo;  // ids 0,1 and 2,3 (0 for a triangle), unsigned order
+    int32_t tag;
+    uint32_t pos;
+  };
+  std::vector<Record> rec(n);
+  for (size_t i = 0; i < n; ++i) {
+    const std::array<uint32_t, N>& t = (*items)[i];
+    const uint64_t hi = (uint64_t{t[0]} << 32) | t[1];
+    const uint64_t lo = (uint64_t{t[2]} << 32) | (N == 4 ? t[N - 1] : 0u);
+    rec[i] = {hi, lo, has_tags ? (*tags)[i] : 0, static_cast<uint32_t>(i)};
+  }
+  std::sort(rec.begin(), rec.end(), [](const Record& a, const Record& b) {
+    if (a.hi != b.hi) return a.hi < b.hi;
+    if (a.lo != b.lo) return a.lo < b.lo;
+    if (a.tag != b.tag) return a.tag < b.tag;
+    return a.pos < b.pos;
   });
-  std::vector<T> sorted(n);
-  for (size_t k = 0; k < n; ++k) sorted[k] = (*items)[perm[k]];
+  std::vector<std::array<uint32_t, N>> sorted(n);
+  for (size_t k = 0; k < n; ++k) sorted[k] = (*items)[rec[k].pos];
   *items = std::move(sorted);
   if (has_tags) {
-    std::vector<int32_t> sorted_tags(n);
-    for (size_t k = 0; k < n; ++k) sorted_tags[k] = (*tags)[perm[k]];
-    *tags = std::move(sorted_tags);
+    for (size_t k = 0; k < n; ++k) (*tags)[k] = rec[k].tag;
   }
 }
 

@@ -153,6 +153,48 @@ TEST(Canonicalize, EmptyTagArraysAreAllowed) {
   EXPECT_TRUE(IsCanonical(m));
 }
 
+// The sort (records with ids packed two to a word, session 15) gives the
+// order of the plain comparison: items lexicographically by unsigned id,
+// then tag (signed), then the original position. Ids above 2^31 (the sign
+// bit of a packed word), repeated items with different and equal tags,
+// negative tags, triangles and tets.
+TEST(Canonicalize, OrderIsItemThenTagThenPosition) {
+  std::mt19937 rng(15);
+  auto id = [&] {
+    const uint32_t small = rng() % 6;
+    return rng() % 3 == 0 ? 0x80000000u + small : small;
+  };
+  TetMesh m;
+  for (int i = 0; i < 3000; ++i) {
+    m.tets.push_back(CanonicalTet({id(), id(), id(), id()}));
+    m.tet_region.push_back(static_cast<int32_t>(rng() % 5) - 2);
+    m.triangles.push_back(CanonicalTriangle({id(), id(), id()}));
+    m.triangle_marker.push_back(static_cast<int32_t>(rng() % 5) - 2);
+  }
+  auto reference = [](auto items, std::vector<int32_t> tags) {
+    std::vector<size_t> perm(items.size());
+    for (size_t i = 0; i < perm.size(); ++i) perm[i] = i;
+    std::stable_sort(perm.begin(), perm.end(), [&](size_t a, size_t b) {
+      if (items[a] != items[b]) return items[a] < items[b];
+      return tags[a] < tags[b];
+    });
+    decltype(items) out_items;
+    std::vector<int32_t> out_tags;
+    for (size_t k : perm) {
+      out_items.push_back(items[k]);
+      out_tags.push_back(tags[k]);
+    }
+    return std::make_pair(out_items, out_tags);
+  };
+  const auto tets = reference(m.tets, m.tet_region);
+  const auto tris = reference(m.triangles, m.triangle_marker);
+  Canonicalize(&m);
+  EXPECT_EQ(m.tets, tets.first);
+  EXPECT_EQ(m.tet_region, tets.second);
+  EXPECT_EQ(m.triangles, tris.first);
+  EXPECT_EQ(m.triangle_marker, tris.second);
+}
+
 TEST(SpatialOrder, IsAPermutationAndDeterministic) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1e3, 1e3);
