@@ -133,6 +133,11 @@ int OracleCompareDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
   const QV pa = ToQ(p) - ToQ(a), pb = ToQ(p) - ToQ(b);
   return sgn(Dot(pa, pa) - Dot(pb, pb));
 }
+int OracleInBall(const Vec3& p, const Vec3& c, double r) {
+  const QV pc = ToQ(p) - ToQ(c);
+  const Q rr = Q(r) * Q(r);
+  return sgn(rr - Dot(pc, pc));
+}
 int OracleDotSign(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return sgn(Dot(ToQ(b) - ToQ(a), ToQ(d) - ToQ(c)));
 }
@@ -421,6 +426,48 @@ TEST(PredicatesTest, ConventionsOnSimpleCases) {
 }
 
 // ------------------------------------------------------ extra predicates
+
+// InBall's static pre-filter (session 15) must only ever return the exact
+// sign: points on the sphere (lattice points of radius 9, exact zeros, in
+// every frame), a radius rounded from the distance (the hardest case: the
+// sign hangs on the last bits of r), nudged by one ulp either way, random
+// points, and extreme scales.
+TEST(PredicatesTest, InBallMatchesOracle) {
+  Gen g(16);
+  const std::vector<Vec3> sphere = SpherePoints(9);
+  int cases = 0, zeros = 0;
+  auto check = [&](const Vec3& p, const Vec3& c, double r) {
+    const int want = OracleInBall(p, c, r);
+    ASSERT_EQ(InBall(p, c, r), want) << "p " << p.x << " " << p.y << " " << p.z << " c " << c.x << " " << c.y << " "
+                                     << c.z << " r " << r;
+    zeros += want == 0;
+    ++cases;
+  };
+  for (const Frame& f : kFrames) {
+    const double r = std::ldexp(9.0, f.k);
+    const Vec3 c = Apply(f, Vec3{0, 0, 0});
+    for (const Vec3& s : sphere) {
+      const Vec3 p = Apply(f, s);
+      check(p, c, r);
+      check(p, c, std::nextafter(r, HUGE_VAL));
+      check(p, c, std::nextafter(r, 0.0));
+      std::array<Vec3, 1> q = {p};
+      g.NudgeOneUlp(q);
+      check(q[0], c, r);
+    }
+  }
+  for (int i = 0; i < N(20000); ++i) {
+    const double scale = std::ldexp(1.0, g.Int(-300, 300));
+    const Vec3 c = g.Point3(scale), p = g.Point3(scale);
+    const double d = Norm(p - c);
+    check(p, c, d);
+    check(p, c, std::nextafter(d, HUGE_VAL));
+    check(p, c, std::nextafter(d, 0.0));
+    check(p, c, g.Uniform(0, 2 * scale));
+  }
+  EXPECT_GT(zeros, 100);
+  EXPECT_GT(cases, N(80000));
+}
 
 TEST(PredicatesTest, ExtraPredicatesMatchOracle) {
   Gen g(15);
