@@ -30,12 +30,11 @@ uint64_t EdgeKey(uint32_t a, uint32_t b) {
   return (static_cast<uint64_t>(a) << 32) | b;
 }
 
-// V(u) ⊂ B(u, R_u) (R_u = the farthest Voronoi corner; +∞ on the hull), so
-// V(u) can meet B(c, ρ) only if |uc| − R_u ≤ ρ. Conservative by a relative
-// 1e-9 (R_u and |uc| are rounded).
-bool CellMayMeetBall(const Delaunay3& dt, VertexId u, const CollarBall& b) {
-  if (dt.IsHullVertex(u)) return true;
-  const double r = dt.OutRadius(u);
+// V(u) ⊂ B(u, R_u) (R_u = the farthest Voronoi corner; +∞ on the hull, which
+// OutRadius returns when a star tet is a ghost: |uc| − ∞ passes), so V(u) can
+// meet B(c, ρ) only if |uc| − R_u ≤ ρ. Conservative by a relative 1e-9 (R_u
+// and |uc| are rounded).
+bool CellMayMeetBall(const Delaunay3& dt, VertexId u, double r, const CollarBall& b) {
   return geom::Dist(dt.Point(u), b.center) - r <= b.radius * (1 + 1e-9) + 1e-9 * r;
 }
 
@@ -46,9 +45,11 @@ bool CellMayMeetBall(const Delaunay3& dt, VertexId u, const CollarBall& b) {
 // all. `seen` is zero scratch of NumVertices() entries, left zero.
 // `touched` receives every vertex read (the candidates and their neighbours:
 // the cache's dependency set).
+// `out_radius(u)` is R_u (Delaunay3::OutRadius, possibly memoised).
+template <typename OutRadiusFn>
 std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b, bool local,
                                         TetId hint, std::vector<uint8_t>* seen, VertexId* center_vertex,
-                                        std::vector<uint32_t>* touched_out) {
+                                        std::vector<uint32_t>* touched_out, OutRadiusFn&& out_radius) {
   std::vector<uint32_t> out;
   touched_out->clear();
   if (!local) {
@@ -73,7 +74,7 @@ std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b
       if ((*seen)[u.value()]) continue;
       (*seen)[u.value()] = 1;
       touched.push_back(u.value());
-      if (CellMayMeetBall(dt, u, b)) queue.push_back(u.value());
+      if (CellMayMeetBall(dt, u, out_radius(u), b)) queue.push_back(u.value());
     }
   }
   for (uint32_t v : touched) (*seen)[v] = 0;
@@ -387,6 +388,17 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   std::vector<CollarRestrictionCache::PerBall> per_ball;
   if (cache != nullptr) per_ball.resize(nb);
   r.center_vertex.assign(nb, VertexId());
+  // R_u, memoised in the cache by u's generation (its star, hence its
+  // Voronoi cell, is the same while the generation is).
+  auto out_radius = [&](VertexId u) -> double {
+    if (cache == nullptr) return dt.OutRadius(u);
+    std::vector<CollarRestrictionCache::OutRadiusMemo>& memo = cache->out_radius;
+    if (memo.size() <= u.value()) memo.resize(dt.NumVertices() + dt.NumVertices() / 2 + 16);
+    CollarRestrictionCache::OutRadiusMemo& m = memo[u.value()];
+    const uint32_t g = cache->generation(u.value());
+    if (!m.valid || m.generation != g) m = {g, true, dt.OutRadius(u)};
+    return m.radius;
+  };
   for (uint32_t i = 0; i < nb; ++i) {
     if (reuse) {
       CollarRestrictionCache::PerBall& pb = cache->per_ball[i];
@@ -417,7 +429,8 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
     if (cache != nullptr && i < cache->per_ball.size()) from = cache->per_ball[i].center_vertex;
     if (!from.valid() && i > 0) from = r.center_vertex[i - 1];
     const TetId hint = from.valid() && from.value() < dt.NumVertices() ? dt.VertexTet(from) : TetId();
-    cand[i] = CandidateVertices(dt, balls[i], opt.local_search, hint, &seen, &r.center_vertex[i], &touched);
+    cand[i] = CandidateVertices(dt, balls[i], opt.local_search, hint, &seen, &r.center_vertex[i], &touched,
+                                out_radius);
     r.candidates_per_ball[i] = static_cast<uint32_t>(cand[i].size());
     for (uint32_t v : cand[i]) is_cand[v] = 1;
     tris.clear();

@@ -127,6 +127,16 @@ struct CollarRestrictionCache {
   std::vector<std::pair<uint32_t, uint32_t>> circle_balls;
   std::vector<PerBall> per_ball;
   CollarRestriction last;  // its circle members are reused
+  // Per vertex: R_v (Delaunay3::OutRadius) at the generation it was computed
+  // at; the candidate search of a recomputed ball reads it for cells whose
+  // stars did not change since (wedge-1.smesh: the star walks and
+  // circumcentres of OutRadius were ~16% of the run).
+  struct OutRadiusMemo {
+    uint32_t generation = 0;
+    bool valid = false;
+    double radius = 0;
+  };
+  std::vector<OutRadiusMemo> out_radius;
 };
 
 // `cache` may be null (every ball computed); with a cache the result is the
