@@ -698,9 +698,11 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
   for (uint32_t bi = 0; bi < nb; ++bi) {
     const std::vector<uint32_t> cs = circles_on_s(bi);
     for (uint32_t k : cs) rep.circles_on_surface_per_ball[bi] += res.circle_state[k] == 1;
-    std::vector<std::array<uint32_t, 3>> t3;
-    for (uint32_t i : of_ball[bi]) t3.push_back(triple(i));
-    rep.euler_per_ball[bi] = Euler(t3);
+    if (opt.topology_summary) {
+      std::vector<std::array<uint32_t, 3>> t3;
+      for (uint32_t i : of_ball[bi]) t3.push_back(triple(i));
+      rep.euler_per_ball[bi] = Euler(t3);
+    }
     const CollarBall& b = balls[bi];
     if (of_ball[bi].empty()) {
       // (d) The partial sphere lies inside one cell, or is covered: the
@@ -950,10 +952,12 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     if (comp_id[root] < 0) comp_id[root] = rep.num_components++;
     comp_id[bi] = comp_id[root];
   }
-  std::vector<std::vector<std::array<uint32_t, 3>>> comp_tris(rep.num_components);
-  for (const Unique& u : uniq) comp_tris[comp_id[tris[u.best].ball]].push_back(u.v);
-  for (const auto& ct : comp_tris) rep.euler_per_component.push_back(Euler(ct));
-  {
+  if (opt.topology_summary) {
+    std::vector<std::vector<std::array<uint32_t, 3>>> comp_tris(rep.num_components);
+    for (const Unique& u : uniq) comp_tris[comp_id[tris[u.best].ball]].push_back(u.v);
+    for (const auto& ct : comp_tris) rep.euler_per_component.push_back(Euler(ct));
+  }
+  if (opt.topology_summary) {
     std::vector<uint32_t> vs;
     for (const Unique& u : uniq) vs.insert(vs.end(), u.v.begin(), u.v.end());
     std::sort(vs.begin(), vs.end());

@@ -56,6 +56,11 @@ struct CollarSurfaceOptions {
   // found by a walk from the centre's nearest vertex). false = every vertex
   // (the reference the local search is measured against).
   bool local_search = true;
+  // Fill the report's topology summary (χ per partial sphere and per
+  // component, components of the triangulation). Diagnostics only: the
+  // repairs do not read them; the refiner turns it off (their sorts were ~3%
+  // of wedge-1.smesh's COLLAR rounds).
+  bool topology_summary = true;
 };
 
 // One COLLAR event (Definition 38's RepBall B(x, radius) to destroy): insert x.

@@ -2234,6 +2234,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   }
   const CollarDescription desc = BuildCollarDescription(collars_.balls());
   CollarSurfaceOptions copt;
+  copt.topology_summary = false;  // χ and components: diagnostics the rounds do not read
   copt.sigma = options_.max_rep_angle;
   copt.delta = collar_snap_;
   surface_report_ = CollarSurfaceReport();
