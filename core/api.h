@@ -31,7 +31,8 @@ struct MeshParams {
   double min_dihedral = 0.0;
   // Return the whole bounding-domain mesh instead of the PLC's regions.
   bool keep_bounding_box = false;
-  // Hard cap on output vertices; 0: derived from the input (no-progress guard).
+  // Hard cap on the refiner's vertices (M_Ω and feature meshes); 0: derived
+  // from the input, max(10^6, 2000 × input points) (the no-progress guard).
   uint64_t max_vertices = 0;
 };
 

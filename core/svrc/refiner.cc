@@ -566,12 +566,11 @@ class Refiner {
  private:
   RefineStats stats_;
   uint64_t budget_ = 0;
-  // Where the budget came from, for its error: the default (max(10^6, 1000 ×
-  // input points)) can be raised; bunny.off's collar stage needed ~3.7 M
-  // vertices, 6% over its default, and meshed with 12 M (session 15).
+  // Where the budget came from, for its error: the default (max(10^6, 2000 ×
+  // input points)) can be raised.
   std::string BudgetHint() const {
     if (options_.max_vertices != 0) return " (a budget set by the caller)";
-    return absl::StrCat(" (the default: max(1000000, 1000 x ", num_input_,
+    return absl::StrCat(" (the default: max(1000000, 2000 x ", num_input_,
                         " input points); a larger max_vertices (svrc mesh --max-vertices N) lets it go on)");
   }
   // The cell size IsLive computed for the event Destroy gets next.
@@ -724,8 +723,11 @@ absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const 
   features_ = FeatureTable::Build(complex);
   seg_mesh0_ = complex.segments.empty() ? 0 : features_.OfSegment(0).value();
   facet_mesh0_ = complex.facets.empty() ? 0 : features_.OfFacet(0).value();
+  // The default guard: 2000 vertices per input point, at least 10^6. 1000 per
+  // point (until session 15) stopped bunny.off's collar stage 6% short (it
+  // needs ~3.7 M vertices in M_Ω and the facet meshes for 3,485 points).
   budget_ = options_.max_vertices != 0 ? options_.max_vertices
-                                       : std::max<uint64_t>(1'000'000, 1000ull * num_input_);
+                                       : std::max<uint64_t>(1'000'000, 2000ull * num_input_);
   // Global ids = SoS priorities: inputs first (in input order), then corners.
   complex_ = &complex;
   for (uint32_t i = 0; i < num_input_; ++i) {

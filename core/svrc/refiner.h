@@ -105,8 +105,10 @@ struct RefineOptions {
   // −22/−10% tets, knife_edge −17%, hinge.stl's facet meshes −43% at a
   // 100,000-vertex budget; volume inputs unchanged (cube 1e-4 −0.7%).
   double facet_tau_factor = 2.0;
-  // Vertex budget of M_Ω (corners, inputs and Steiner points); 0: derived,
-  // max(10^6, 1000·n). Exceeding it returns RESOURCE_EXHAUSTED.
+  // Vertex budget of M_Ω (corners, inputs and Steiner points) plus the
+  // segment and facet meshes' own vertices; 0: derived,
+  // max(10^6, 2000·n) (1000·n until session 15). Exceeding it returns
+  // RESOURCE_EXHAUSTED.
   uint64_t max_vertices = 0;
   // Polled every `poll_interval` insertions (cancellation/deadline); a non-OK
   // status aborts the run and is returned. May be null.
