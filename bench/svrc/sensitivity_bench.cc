@@ -72,8 +72,8 @@ std::atomic<int64_t> g_heap_peak{0};
 void* CountedAlloc(size_t n) {
   void* p = std::malloc(n == 0 ? 1 : n);
   if (p == nullptr) throw std::bad_alloc();
-  const int64_t now = g_heap_now.fetch_add(static_cast<int64_t>(malloc_usable_size(p)), std::memory_order_relaxed) +
-                      static_cast<int64_t>(malloc_usable_size(p));
+  const int64_t size = static_cast<int64_t>(malloc_usable_size(p));
+  const int64_t now = g_heap_now.fetch_add(size, std::memory_order_relaxed) + size;
   int64_t peak = g_heap_peak.load(std::memory_order_relaxed);
   while (now > peak && !g_heap_peak.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
   }

@@ -83,36 +83,34 @@ namespace {
 uint64_t PackedSize(uint32_t size) { return size == 0 ? 0 : std::max(kMinCap, std::bit_ceil(size)); }
 }  // namespace
 
-void LocationGraph::MaybeCompactCells() {
+template <typename Entry>
+void LocationGraph::CompactIfSparse(Arena<Entry>& arena, std::vector<Span*>& spans) {
   uint64_t total = 0;
-  std::vector<Span*> spans;
-  for (std::vector<CellSpanT>& mesh_spans : cell_spans_) {
-    for (CellSpanT& s : mesh_spans) {
-      if (s.cap == 0) continue;
-      total += PackedSize(s.size);
-      spans.push_back(&s);
-    }
-  }
-  if (3 * total > 2 * cell_arena_.PoolSize()) return;
+  for (const Span* s : spans) total += PackedSize(s->size);
+  if (3 * total > 2 * arena.PoolSize()) return;
   std::sort(spans.begin(), spans.end(), [](const Span* a, const Span* b) { return a->offset < b->offset; });
-  cell_arena_.Compact(spans);
+  arena.Compact(spans);
   ++stats_.compactions;
 }
 
+void LocationGraph::MaybeCompactCells() {
+  std::vector<Span*> spans;
+  for (std::vector<CellSpanT>& mesh_spans : cell_spans_) {
+    for (CellSpanT& s : mesh_spans) {
+      if (s.cap != 0) spans.push_back(&s);
+    }
+  }
+  CompactIfSparse(cell_arena_, spans);
+}
+
 void LocationGraph::MaybeCompactObjects() {
-  uint64_t total = 0;
   std::vector<Span*> spans;
   for (std::vector<Span>* list : {&ball_spans_, &collar_spans_}) {
     for (Span& s : *list) {
-      if (s.cap == 0) continue;
-      total += PackedSize(s.size);
-      spans.push_back(&s);
+      if (s.cap != 0) spans.push_back(&s);
     }
   }
-  if (3 * total > 2 * object_arena_.PoolSize()) return;
-  std::sort(spans.begin(), spans.end(), [](const Span* a, const Span* b) { return a->offset < b->offset; });
-  object_arena_.Compact(spans);
-  ++stats_.compactions;
+  CompactIfSparse(object_arena_, spans);
 }
 
 inline LocationGraph::CellSpanT& LocationGraph::CellSpan(MeshId mesh, uint32_t cell) {

@@ -229,6 +229,9 @@ class LocationGraph {
   // --max-volume 1e-4: 197k cell-side entries for at most 44k live links).
   void MaybeCompactCells();
   void MaybeCompactObjects();
+  // The shared step: `spans` are every span of `arena` with a block.
+  template <typename Entry>
+  void CompactIfSparse(Arena<Entry>& arena, std::vector<Span*>& spans);
 
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;

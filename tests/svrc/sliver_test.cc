@@ -433,13 +433,6 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
   EXPECT_GT(sequences, 0u);  // the depth-2 search was exercised (and kept every invariant above)
 }
 
-
-// The pass's own quality evaluation skips atan2 for edges that cannot hold
-// the smallest or largest dihedral angle; every field must still be the same
-// double as mesh::ComputeTetQuality's (outputs and stats depend on it). Tets
-// of every shape: random, slivers (four points near a circle, lifted off its
-// plane by 1e-3 .. 1e-15), needles, caps, exactly flat ones, regular-ish ones
-// with ties between angles, and edge lengths over many scales.
 // The pass measures an input tet's dihedral angles only when its volume
 // does not already place them all between the target and 180° − target.
 // Its "before" statistics must still be those of every tet: checked against
@@ -447,8 +440,7 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
 // (the extremes come from measured tets) and targets below the mesh's
 // smallest angle (nothing is bad: the skipped tets must be measured for the
 // extremes). A flip pass that then runs must see the same qualities too:
-// its output equals a run with lazy angles impossible (target 0 skips
-// nothing, target 89.9 measures almost everything).
+// the "after" statistics must be those of the output's tets.
 TEST(Sliver, SkippedAnglesLeaveTheStatisticsExact) {
   std::mt19937_64 rng(15);
   std::uniform_real_distribution<double> u(0, 1);
@@ -456,14 +448,18 @@ TEST(Sliver, SkippedAnglesLeaveTheStatisticsExact) {
   for (int i = 0; i < 400; ++i) pos.push_back({u(rng), u(rng), u(rng)});
   absl::StatusOr<delaunay::PointSetResult> del = delaunay::TetrahedralizePointSet(pos);
   ASSERT_TRUE(del.ok()) << del.status();
-  double min_all = 180, max_all = 0;
-  for (const Tet& t : del->tets) {
-    Tet s = t;
-    std::sort(s.begin(), s.end());
-    const SliverTetQuality q = MeasureSliverTet(pos[s[0]], pos[s[1]], pos[s[2]], pos[s[3]]);
-    min_all = std::min(min_all, q.min_dihedral_deg);
-    max_all = std::max(max_all, q.max_dihedral_deg);
-  }
+  // Smallest and largest dihedral angle over `tets`, each measured directly.
+  auto extremes = [&](const std::vector<Tet>& tets) {
+    double lo = 180, hi = 0;
+    for (Tet s : tets) {
+      std::sort(s.begin(), s.end());
+      const SliverTetQuality q = MeasureSliverTet(pos[s[0]], pos[s[1]], pos[s[2]], pos[s[3]]);
+      lo = std::min(lo, q.min_dihedral_deg);
+      hi = std::max(hi, q.max_dihedral_deg);
+    }
+    return std::pair(lo, hi);
+  };
+  const auto [min_all, max_all] = extremes(del->tets);
   ASSERT_LT(min_all, 5.0);  // a random Delaunay mesh has slivers
   for (double target : {15.0, 5.0, min_all * 0.5, 1e-3}) {
     SliverInput in;
@@ -479,20 +475,18 @@ TEST(Sliver, SkippedAnglesLeaveTheStatisticsExact) {
     EXPECT_EQ(r->stats.min_dihedral_before, min_all) << "target " << target;
     EXPECT_EQ(r->stats.max_dihedral_before, max_all) << "target " << target;
     EXPECT_EQ(r->stats.bad_before, bad) << "target " << target;
-    // After: the extremes of the output's tets, measured directly.
-    double min_after = 180, max_after = 0;
-    for (const Tet& t : r->tets) {
-      Tet s = t;
-      std::sort(s.begin(), s.end());
-      const SliverTetQuality q = MeasureSliverTet(pos[s[0]], pos[s[1]], pos[s[2]], pos[s[3]]);
-      min_after = std::min(min_after, q.min_dihedral_deg);
-      max_after = std::max(max_after, q.max_dihedral_deg);
-    }
+    const auto [min_after, max_after] = extremes(r->tets);
     EXPECT_EQ(r->stats.min_dihedral_after, min_after) << "target " << target;
     EXPECT_EQ(r->stats.max_dihedral_after, max_after) << "target " << target;
   }
 }
 
+// The pass's own quality evaluation skips atan2 for edges that cannot hold
+// the smallest or largest dihedral angle; every field must still be the same
+// double as mesh::ComputeTetQuality's (outputs and stats depend on it). Tets
+// of every shape: random, slivers (four points near a circle, lifted off its
+// plane by 1e-3 .. 1e-15), needles, caps, exactly flat ones, regular-ish ones
+// with ties between angles, and edge lengths over many scales.
 TEST(Sliver, MeasureMatchesComputeTetQuality) {
   std::mt19937_64 rng(20261121);
   std::uniform_real_distribution<double> unit(-1, 1);
