@@ -12,6 +12,7 @@
 #include "absl/strings/str_split.h"
 #include "client/cli_util.h"
 #include "client/command.h"
+#include "client/remote_commands.h"
 #include "client/remote_client.h"
 #include "core/codec/container.h"
 #include "proto/convert.h"
@@ -109,11 +110,7 @@ int WatchToEnd(RemoteClient& client, const std::string& job_id, const std::strin
 
 // ---- submit ----
 int RunSubmit(const std::vector<std::string>& argv);
-const Command kSubmit{
-    "submit",
-    "submit IN [--server HOST:PORT] [--watch] [-o OUT] [--request-id ID] [mesh flags as for "
-    "`svrc mesh`]   (prints the job id; --watch shows progress; -o waits and writes the result)",
-    &RunSubmit};
+const Command kSubmit{"submit", RemoteUsage("submit"), &RunSubmit};
 const RegisterCommand kRegSubmit{kSubmit};
 
 int RunSubmit(const std::vector<std::string>& argv) {
@@ -151,7 +148,7 @@ int RunSubmit(const std::vector<std::string>& argv) {
 
 // ---- watch ----
 int RunWatch(const std::vector<std::string>& argv);
-const Command kWatch{"watch", "watch ID [--server HOST:PORT] [-o OUT]", &RunWatch};
+const Command kWatch{"watch", RemoteUsage("watch"), &RunWatch};
 const RegisterCommand kRegWatch{kWatch};
 
 int RunWatch(const std::vector<std::string>& argv) {
@@ -167,8 +164,7 @@ int RunWatch(const std::vector<std::string>& argv) {
 
 // ---- get ----
 int RunGet(const std::vector<std::string>& argv);
-const Command kGet{"get", "get ID [--server HOST:PORT] [-o OUT]   (without -o: the job's state)",
-                   &RunGet};
+const Command kGet{"get", RemoteUsage("get"), &RunGet};
 const RegisterCommand kRegGet{kGet};
 
 int RunGet(const std::vector<std::string>& argv) {
@@ -209,7 +205,7 @@ int RunGet(const std::vector<std::string>& argv) {
 
 // ---- cancel ----
 int RunCancel(const std::vector<std::string>& argv);
-const Command kCancel{"cancel", "cancel ID [--server HOST:PORT]", &RunCancel};
+const Command kCancel{"cancel", RemoteUsage("cancel"), &RunCancel};
 const RegisterCommand kRegCancel{kCancel};
 
 int RunCancel(const std::vector<std::string>& argv) {
@@ -231,8 +227,7 @@ int RunCancel(const std::vector<std::string>& argv) {
 
 // ---- delete ----
 int RunDelete(const std::vector<std::string>& argv);
-const Command kDelete{"delete", "delete ID [--server HOST:PORT]   (forgets a finished job and its result)",
-                      &RunDelete};
+const Command kDelete{"delete", RemoteUsage("delete"), &RunDelete};
 const RegisterCommand kRegDelete{kDelete};
 
 int RunDelete(const std::vector<std::string>& argv) {
@@ -250,8 +245,7 @@ int RunDelete(const std::vector<std::string>& argv) {
 
 // ---- list ----
 int RunList(const std::vector<std::string>& argv);
-const Command kList{"list", "list [--server HOST:PORT] [--state QUEUED,RUNNING,...] [--page-size N]",
-                    &RunList};
+const Command kList{"list", RemoteUsage("list"), &RunList};
 const RegisterCommand kRegList{kList};
 
 int RunList(const std::vector<std::string>& argv) {
@@ -294,8 +288,7 @@ int RunList(const std::vector<std::string>& argv) {
 
 // ---- health ----
 int RunHealth(const std::vector<std::string>& argv);
-const Command kHealth{"health", "health [--server HOST:PORT] [--tls-ca PEM] [--token-file F]   (exit 0 only when SERVING)",
-                      &RunHealth};
+const Command kHealth{"health", RemoteUsage("health"), &RunHealth};
 const RegisterCommand kRegHealth{kHealth};
 
 int RunHealth(const std::vector<std::string>& argv) {

@@ -195,6 +195,43 @@ TEST_F(CliTest, ExitStatuses) {
   fs::remove_all(dir);
 }
 
+// `svrc` holds the local commands and links no service library (they made
+// its start-up three times slower); a remote command runs svrc-remote beside
+// it (client/remote_commands.h). The CliTest cases above go through that
+// hand-over on every submit/watch/get.
+TEST(CliSplitTest, TheLocalBinaryLinksNoServiceLibrary) {
+  const testing::CommandResult needed = testing::RunCommand({"/usr/bin/readelf", "-d", testing::SvrcCliPath()});
+  ASSERT_EQ(needed.exit_code, 0) << needed.err;
+  ASSERT_TRUE(absl::StrContains(needed.out, "(NEEDED)")) << needed.out;
+  for (const char* lib : {"libgrpc", "libprotobuf", "libssl", "libcrypto", "libupb", "libgpr"}) {
+    EXPECT_FALSE(absl::StrContains(needed.out, lib)) << lib << " in\n" << needed.out;
+  }
+}
+
+TEST(CliSplitTest, HelpListsTheRemoteCommandsAndAMissingRemoteBinaryIsNamed) {
+  const testing::CommandResult help = RunSvrc({"--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* c : {"svrc mesh ", "svrc validate ", "svrc submit ", "svrc watch ", "svrc get ", "svrc cancel ",
+                        "svrc delete ", "svrc list ", "svrc health "}) {
+    EXPECT_TRUE(absl::StrContains(help.out, c)) << c << " missing from\n" << help.out;
+  }
+  // A copy of svrc alone in a folder, with a PATH that holds no svrc-remote.
+  const std::string dir = testing::MakeTempDir("cli_lone");
+  const std::string lone = dir + "/svrc";
+  fs::copy_file(testing::SvrcCliPath(), lone);
+  fs::permissions(lone, fs::perms::owner_all);
+  const testing::CommandResult r =
+      testing::RunCommand({"/usr/bin/env", "PATH=" + dir, lone, "list", "--server", "127.0.0.1:1"});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_TRUE(absl::StrContains(r.err, "'list' talks to a server")) << r.err;
+  EXPECT_TRUE(absl::StrContains(r.err, dir + "/svrc-remote (No such file or directory)")) << r.err;
+  // Local commands still work there.
+  const testing::CommandResult v =
+      testing::RunCommand({lone, "validate", testing::CorpusPath("a_convex/cube.poly"), "-q"});
+  EXPECT_EQ(v.exit_code, 0) << v.err;
+  fs::remove_all(dir);
+}
+
 TEST(CliVersionTest, PrintsTheVersion) {
   testing::CommandResult v = RunSvrc({"--version"});
   EXPECT_EQ(v.exit_code, 0);

@@ -180,6 +180,8 @@ CommandResult RunCommand(const std::vector<std::string>& argv) {
   return result;
 }
 
+std::string SvrcCliPath() { return SVRC_CLI_BIN; }
+
 CommandResult RunSvrc(const std::vector<std::string>& args) {
   std::vector<std::string> argv = {SVRC_CLI_BIN};
   argv.insert(argv.end(), args.begin(), args.end());

@@ -59,6 +59,8 @@ struct CommandResult {
 CommandResult RunCommand(const std::vector<std::string>& argv);
 // Runs the svrc CLI binary with `args`.
 CommandResult RunSvrc(const std::vector<std::string>& args);
+// The svrc CLI binary's path.
+std::string SvrcCliPath();
 
 // A TetGen .node file of `n` uniform random points in the unit cube
 // (deterministic for a seed, 6 decimals).
