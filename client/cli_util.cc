@@ -35,7 +35,7 @@ absl::Status ParseDouble(const Args& args, const std::string& flag, std::optiona
 const std::vector<std::string>& MeshValueFlags() {
   static const std::vector<std::string> flags = {
       "--radius-edge", "--max-volume",   "--theta",    "--max-rep-angle",     "--min-dihedral",
-      "--max-vertices", "--deadline",    "--quantization-bits"};
+      "--max-vertices", "--deadline",    "--quantization-bits", "--collar-size-eps"};
   return flags;
 }
 
@@ -92,7 +92,8 @@ absl::StatusOr<MeshOptions> MeshOptionsFromArgs(const Args& args) {
            {"--theta", &o.theta},
            {"--max-rep-angle", &o.max_rep_angle},
            {"--max-volume", &o.max_volume},
-           {"--min-dihedral", &o.min_dihedral}}) {
+           {"--min-dihedral", &o.min_dihedral},
+           {"--collar-size-eps", &o.collar_size_eps}}) {
     if (absl::Status s = ParseDouble(args, flag, field); !s.ok()) return s;
   }
   if (args.switches.count("--keep-bounding-box")) o.keep_bounding_box = true;

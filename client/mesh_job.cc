@@ -30,6 +30,7 @@ absl::Status ValidateOptions(const MeshOptions& o) {
            CheckRange("max_rep_angle", o.max_rep_angle, 0, true, 180, true),
            CheckRange("max_volume", o.max_volume, -inf, true, inf, true),
            CheckRange("min_dihedral", o.min_dihedral, -inf, true, 90, true),
+           CheckRange("collar_size_eps", o.collar_size_eps, 0, false, 1, false),
        }) {
     if (!s.ok()) return s;
   }
@@ -52,6 +53,7 @@ absl::StatusOr<core::MeshParams> ToMeshParams(const MeshOptions& o) {
   if (o.max_volume) p.max_volume = *o.max_volume;
   if (o.min_dihedral) p.min_dihedral = *o.min_dihedral;
   if (o.keep_bounding_box) p.keep_bounding_box = *o.keep_bounding_box;
+  if (o.collar_size_eps) p.collar_size_eps = *o.collar_size_eps;
   p.max_vertices = o.max_vertices;
   return p;
 }
@@ -65,6 +67,7 @@ absl::Status CheckImplemented(const MeshOptions& o, const plc::Plc& plc) {
   if (o.max_volume && *o.max_volume > 0) set.push_back("max_volume");
   if (o.min_dihedral && *o.min_dihedral > 0) set.push_back("min_dihedral");
   if (o.keep_bounding_box && *o.keep_bounding_box) set.push_back("keep_bounding_box");
+  if (o.collar_size_eps && *o.collar_size_eps > 0) set.push_back("collar_size_eps");
   if (set.empty()) return absl::OkStatus();
   return absl::UnimplementedError(absl::StrCat(
       absl::StrJoin(set, ", "),

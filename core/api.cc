@@ -178,6 +178,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     return absl::InvalidArgumentError("radius_edge must be a positive number");
   }
   if (!(params.theta > 0 && params.theta < 1)) return absl::InvalidArgumentError("theta must be in (0, 1)");
+  if (!(params.collar_size_eps >= 0 && params.collar_size_eps <= 1)) {
+    return absl::InvalidArgumentError("collar_size_eps must be in [0, 1] (0: the angle test)");
+  }
   // Not built yet: refuse rather than ignore (thesis §6.2.1 sliver removal).
   if (params.min_dihedral > 0) {
     return absl::UnimplementedError("min_dihedral: sliver removal is not implemented yet");
@@ -227,6 +230,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     options.collars = true;
     options.collar_surface = true;
     options.max_rep_angle = params.max_rep_angle * M_PI / 180;
+    options.collar_size_eps = params.collar_size_eps;
   } else if (!crease.empty()) {
     options.attempt_creases = true;
     options.max_vertices = CreaseBudget(*complex, params);
@@ -362,6 +366,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   mesh.provenance.svrc_version = Version();
   mesh.provenance.parameters = absl::StrCat("mode=svrc radius_edge=", params.radius_edge, " theta=", params.theta,
                                             use_collars ? absl::StrCat(" max_rep_angle=", params.max_rep_angle) : "",
+                                            use_collars && params.collar_size_eps > 0
+                                                ? absl::StrCat(" collar_size_eps=", params.collar_size_eps)
+                                                : "",
                                             " keep_bounding_box=", params.keep_bounding_box ? 1 : 0);
   mesh.provenance.input_sha256 = plc.input_sha256;
   mesh.stats.Set("tets", static_cast<double>(mesh.tets.size()));

@@ -25,6 +25,13 @@ struct MeshParams {
   // §1). 60, not the guide's 30: at 30 the COLLAR rounds do not settle yet
   // (measured on two facets at 30°, docs/svrc-collars.md "Wiring status").
   double max_rep_angle = 60.0;
+  // The simple criterion of thesis Ch. 6 for the COLLAR rounds: > 0 repairs a
+  // representation ball of radius > collar_size_eps · css(x) (the collar
+  // surface size) instead of an angle > max_rep_angle; the topology tests
+  // stay. It bounds no representation angle, hence no dihedral angle next to
+  // the creases (docs/svrc-collars.md "Session 16" measures both). 0: the
+  // angle test (default). At most 1.
+  double collar_size_eps = 0.0;
   // Global max tet volume in input units³; <= 0: none.
   double max_volume = 0.0;
   // Sliver removal target in degrees (thesis §6.2.1); <= 0: off.

@@ -545,6 +545,7 @@ class Refiner {
   double collar_snap_ = 0;  // the COLLAR rounds' snap band (RefineOptions::collar_snap, then its fallback)
   CollarSurfaceReport surface_report_;
   uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, crossing_count_ = 0;
+  std::array<uint64_t, 4> collar_repairs_by_reason_{};  // by CollarRepair::Reason
   // The COLLAR rounds' restricted Delaunay of S, per ball, reused across
   // rounds while the cells it read keep their generations.
   CollarRestrictionCache restriction_cache_;
@@ -2247,6 +2248,8 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   copt.topology_summary = false;  // χ and components: diagnostics the rounds do not read
   copt.sigma = options_.max_rep_angle;
   copt.delta = collar_snap_;
+  copt.size_criterion = options_.collar_size_eps > 0;
+  if (copt.size_criterion) copt.eps_s = options_.collar_size_eps;
   surface_report_ = CollarSurfaceReport();
   if (!restriction_cache_.generation) {
     restriction_cache_.generation = [this](uint32_t v) { return omega_.CellGeneration(VertexId(v)); };
@@ -2354,6 +2357,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     absl::Status st = DestroyOmegaAt(r.x, r.radius, dt.VertexTet(v), v, Cd{3, static_cast<uint8_t>(r.collar_dim)});
     if (!st.ok()) return st;
     ++collar_repairs_;
+    ++collar_repairs_by_reason_[r.reason];
     any = true;
   }
   // The 2D collar systems of the facets a collar ball reaches.
@@ -3166,6 +3170,7 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.collar_balls_computed = restriction_cache_.balls_computed;
   st.collar_balls_reused = restriction_cache_.balls_reused;
   st.collar_repairs = collar_repairs_;
+  st.collar_repairs_by_reason = collar_repairs_by_reason_;
   st.arc_repairs = arc_repairs_;
   st.stitched_arc_crossings = stitched_arc_crossings_;
   st.steiner_vertices = st.vertices - 8 - st.input_vertices - segment_in_omega - st.facet_vertices_in_omega;
@@ -3347,6 +3352,12 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
     out->Set("svrc.arc_facets_settled", static_cast<double>(arc_facets_settled));
   }
   out->Set("svrc.collar_repairs", static_cast<double>(collar_repairs));
+  if (collars > 0) {
+    for (int k = 0; k < 4; ++k) {
+      out->Set(absl::StrCat("svrc.collar_repairs.", kCollarRepairName[k]),
+               static_cast<double>(collar_repairs_by_reason[k]));
+    }
+  }
   out->Set("svrc.arc_repairs", static_cast<double>(arc_repairs));
   if (collars > 0) out->Set("svrc.stitched_arc_crossings", static_cast<double>(stitched_arc_crossings));
   out->Set("svrc.collar_pairs", static_cast<double>(collar_pairs));

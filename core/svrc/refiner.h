@@ -161,6 +161,9 @@ struct RefineOptions {
   // σ: the largest representation angle of the collar surface (radians;
   // MeshParams::max_rep_angle).
   double max_rep_angle = 0.5235987755982988;
+  // > 0: the COLLAR rounds test RepBall radius > collar_size_eps · css(x)
+  // (Ch. 6) instead of the angle (MeshParams::collar_size_eps).
+  double collar_size_eps = 0;
   // Snap band of the partial spheres and circles, relative to their radius
   // (thesis §3.1.2 δ): a vertex that near S counts as on S for the angle
   // test only. The stitched tets use the true positions, so with δ > 0 they
@@ -224,6 +227,9 @@ struct RefineStats {
   StitchShape stitch;
   double collar_snap = 0;          // the snap band δ in force at the end of the COLLAR rounds
   uint64_t collar_repairs = 0;     // points inserted on S in M_Ω
+  // Of the COLLAR rounds' points, by reason: topology, angle, circle, size
+  // (CollarRepair::Reason; the stitch-failure repairs are not in it).
+  std::array<uint64_t, 4> collar_repairs_by_reason{};
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end

@@ -103,6 +103,29 @@ TEST_F(CliTest, PlcLocalAndRemoteOutputsAreByteIdentical) {
   fs::remove_all(dir);
 }
 
+// A creased input with a collar option (--collar-size-eps, the Ch. 6 size
+// criterion): the flag reaches the server's mesher (proto field
+// collar_size_eps), so local and remote .svrc outputs are byte-identical, and
+// they differ from the default criterion's.
+TEST_F(CliTest, CollarOptionLocalAndRemoteOutputsAreByteIdentical) {
+  ASSERT_TRUE(server_->ok());
+  const std::string dir = testing::MakeTempDir("cli_collar_identity");
+  const std::string input = testing::CorpusPath("c_creases/knife_edge.poly");
+  const testing::CommandResult local =
+      RunSvrc({"mesh", input, "-o", dir + "/local.svrc", "--quiet", "--collar-size-eps", "0.3"});
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  const testing::CommandResult remote = RunSvrc({"submit", input, "--server", server_->address(), "--watch",
+                                                 "-o", dir + "/remote.svrc", "--collar-size-eps", "0.3"});
+  ASSERT_EQ(remote.exit_code, 0) << remote.err;
+  const testing::CommandResult plain = RunSvrc({"mesh", input, "-o", dir + "/plain.svrc", "--quiet"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const std::string a = testing::ReadFileOrFail(dir + "/local.svrc");
+  EXPECT_TRUE(a == testing::ReadFileOrFail(dir + "/remote.svrc"));
+  EXPECT_FALSE(a == testing::ReadFileOrFail(dir + "/plain.svrc"));
+  EXPECT_EQ(RunSvrc({"mesh", input, "-o", dir + "/x.svrc", "--collar-size-eps", "1.5"}).exit_code, 2);
+  fs::remove_all(dir);
+}
+
 TEST_F(CliTest, SubmitPrintsTheJobIdThenGetListAndHealthWork) {
   ASSERT_TRUE(server_->ok());
   const std::string dir = testing::MakeTempDir("cli_submit");

@@ -264,6 +264,44 @@ TEST(CreaseMesh, CorpusInputsThatMesh) {
   }
 }
 
+// The simple criterion of the thesis' Ch. 6 (MeshParams::collar_size_eps):
+// the COLLAR rounds repair RepBalls larger than ε_s·css(x) instead of angles
+// above σ. It meshes, conforms and keeps radius-edge ≤ 2 away from the
+// creases; its repairs are size repairs, never angle ones, and it is recorded
+// in the provenance. It bounds no angle, so no dihedral bound is asserted
+// (docs/svrc-collars.md "Session 16" measures both criteria).
+TEST(CreaseMesh, SizeCriterionMeshesKnifeEdge) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/knife_edge.poly"));
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  core::MeshParams params;
+  params.collar_size_eps = 0.3;
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(*plc, params);
+  ASSERT_TRUE(m.ok()) << m.status();
+  const mesh::ConformityReport rep = mesh::CheckConformity(*plc, *m);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(*plc, *m));
+  EXPECT_GT(q.crease.num_tets, 0u);
+  EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9));
+  EXPECT_GT(m->stats.Get("svrc.collar_repairs.size"), 0);
+  EXPECT_EQ(m->stats.Get("svrc.collar_repairs.angle", -1), 0);
+  EXPECT_NE(m->provenance.parameters.find("collar_size_eps=0.3"), std::string::npos) << m->provenance.parameters;
+  // The angle criterion (the default) repairs angles and no sizes.
+  absl::StatusOr<mesh::TetMesh> angle = core::MeshPlc(*plc, {});
+  ASSERT_TRUE(angle.ok()) << angle.status();
+  EXPECT_GT(angle->stats.Get("svrc.collar_repairs.angle"), 0);
+  EXPECT_EQ(angle->stats.Get("svrc.collar_repairs.size", -1), 0);
+  EXPECT_EQ(angle->provenance.parameters.find("collar_size_eps"), std::string::npos);
+  std::printf("knife_edge: size criterion 0.3 %zu tets (%g size repairs), angle criterion %zu tets (%g angle repairs)\n",
+              m->tets.size(), m->stats.Get("svrc.collar_repairs.size"), angle->tets.size(),
+              angle->stats.Get("svrc.collar_repairs.angle"));
+  params.collar_size_eps = 1.5;
+  const absl::StatusOr<mesh::TetMesh> bad = core::MeshPlc(*plc, params);
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument) << bad.status();
+}
+
 // wedge-1.smesh: a solid wedge of 1° (boundary facets meeting at 1°, and
 // an 89° crease along its far edge). Its collar balls along the 89° crease
 // have one radius, so two neighbours meet on their bisector — the Voronoi
