@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "core/geometry/predicates.h"
 
@@ -214,6 +215,54 @@ bool InsideAnyBall(const Vec3& p, std::span<const CollarBall> balls) {
   for (const CollarBall& b : balls) {
     if (OutsideBox(p, b)) continue;
     if (geom::InBall(p, b.center, b.radius) > 0) return true;
+  }
+  return false;
+}
+
+namespace {
+// The cell of side 2^level holding coordinate v (exact: a power-of-two scale).
+int64_t CellOf(double v, int32_t level) { return static_cast<int64_t>(std::floor(std::ldexp(v, -level))); }
+}  // namespace
+
+SurfaceBallGrid::SurfaceBallGrid(std::span<const CollarBall> balls) : balls_(balls) {
+  entries_.reserve(balls.size() * 2);
+  for (uint32_t j = 0; j < balls.size(); ++j) {
+    const CollarBall& b = balls[j];
+    const Vec3& c = b.center;
+    // A double x strictly inside the ball has c − r < x < c + r, and rounding
+    // is monotone, so fl(c − r) ≤ x ≤ fl(c + r): the cells of that box hold
+    // every point InBall can call inside. 2^level > 2r: at most two cells
+    // per axis.
+    const double w = b.radius;
+    const int32_t level = std::ilogb(2 * w) + 1;
+    const int64_t lo[3] = {CellOf(c.x - w, level), CellOf(c.y - w, level), CellOf(c.z - w, level)};
+    const int64_t hi[3] = {CellOf(c.x + w, level), CellOf(c.y + w, level), CellOf(c.z + w, level)};
+    for (int64_t ix = lo[0]; ix <= hi[0]; ++ix) {
+      for (int64_t iy = lo[1]; iy <= hi[1]; ++iy) {
+        for (int64_t iz = lo[2]; iz <= hi[2]; ++iz) entries_.push_back({level, ix, iy, iz, j});
+      }
+    }
+    levels_.push_back(level);
+  }
+  auto key = [](const Entry& e) { return std::tuple(e.level, e.ix, e.iy, e.iz, e.ball); };
+  std::sort(entries_.begin(), entries_.end(), [&](const Entry& a, const Entry& b) { return key(a) < key(b); });
+  std::sort(levels_.begin(), levels_.end());
+  levels_.erase(std::unique(levels_.begin(), levels_.end()), levels_.end());
+}
+
+bool SurfaceBallGrid::InsideAny(const Vec3& p, uint32_t skip_a, uint32_t skip_b) const {
+  for (const int32_t level : levels_) {
+    const Entry probe{level, CellOf(p.x, level), CellOf(p.y, level), CellOf(p.z, level), 0};
+    auto cell = [](const Entry& e) { return std::tuple(e.level, e.ix, e.iy, e.iz); };
+    auto it = std::lower_bound(entries_.begin(), entries_.end(), probe,
+                               [&](const Entry& a, const Entry& b) { return cell(a) < cell(b); });
+    for (; it != entries_.end() && cell(*it) == cell(probe); ++it) {
+      const uint32_t j = it->ball;
+      if (j == skip_a || j == skip_b) continue;
+      const CollarBall& b = balls_[j];
+      if (OutsideBox(p, b)) continue;
+      if (geom::InBall(p, b.center, b.radius) > 0) return true;
+    }
   }
   return false;
 }

@@ -87,7 +87,7 @@ std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b
 // which therefore meet the ball). Same constructions as
 // RestrictedSphereTriangles; the angle uses each vertex snapped to this
 // sphere (Snap, §3.1.2).
-void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, uint32_t ball,
+void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, const SurfaceBallGrid& grid, uint32_t ball,
                      std::span<const uint32_t> cand, const std::vector<uint8_t>& is_cand,
                      double delta, std::vector<RestrictedTriangle>* out) {
   const CollarBall& b = balls[ball];
@@ -133,7 +133,7 @@ void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, uin
         int kept = 0;
         for (int k = 0; k < nr; ++k) {
           const Vec3 x = ct + s[k] * (end - ct);
-          if (!OnCollarSurface(x, ball, balls)) continue;
+          if (!grid.OnSurface(x, ball)) continue;
           const double ang = RepresentationAngle(nrm, x, b.center);
           if (kept == 0 || ang > rt.angle) {
             rt.x = x;
@@ -184,8 +184,9 @@ std::vector<CollarBall> OtherBalls(std::span<const CollarBall> balls, uint32_t a
 // Restricted edges of one circle among Delaunay edges with both ends in
 // `both` (candidates of both of its balls). Same construction and
 // nearest-vertex acceptance as RestrictedCircleEdges.
-void CircleEdges(const Delaunay3& dt, const Circle3& circle, std::span<const CollarBall> others,
+void CircleEdges(const Delaunay3& dt, const CollarCircle& cc, const SurfaceBallGrid& grid,
                  std::span<const uint32_t> both, double delta, std::vector<RestrictedEdge>* out) {
+  const Circle3& circle = cc.circle;
   Vec3 u, w;
   CircleFrame(circle, &u, &w);
   std::vector<VertexId> nb, nbb;  // nbb: neighbours of nbb_of, fetched once per edge
@@ -207,7 +208,7 @@ void CircleEdges(const Delaunay3& dt, const Circle3& circle, std::span<const Col
       const double phi = std::atan2(B, A), half = std::acos(D / amp);
       for (double t : {phi - half, phi + half}) {
         const Vec3 x = circle.center + circle.radius * (std::cos(t) * u + std::sin(t) * w);
-        if (InsideAnyBall(x, others)) continue;
+        if (grid.InsideAny(x, cc.a, cc.b)) continue;
         // Most roots of the bisector plane are not on the Voronoi facet of
         // (a, b): a neighbour w of a or b nearer to x than both by a margin
         // shows it, and then the nearest vertex is nearer still, neither a
@@ -366,6 +367,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   CollarRestriction r;
   const std::span<const CollarBall> balls(collars.balls);
   const size_t nb = balls.size(), nc = collars.circles.size();
+  const SurfaceBallGrid grid(balls);
   r.candidates_per_ball.assign(nb, 0);
   r.circle_edges.resize(nc);
   r.circle_params.resize(nc);
@@ -434,7 +436,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
     r.candidates_per_ball[i] = static_cast<uint32_t>(cand[i].size());
     for (uint32_t v : cand[i]) is_cand[v] = 1;
     tris.clear();
-    SphereTriangles(dt, balls, i, cand[i], is_cand, opt.delta, &tris);
+    SphereTriangles(dt, balls, grid, i, cand[i], is_cand, opt.delta, &tris);
     for (uint32_t v : cand[i]) is_cand[v] = 0;
     r.triangles.insert(r.triangles.end(), tris.begin(), tris.end());
     if (cache != nullptr) {
@@ -468,7 +470,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
     std::set_intersection(cand[cc.a].begin(), cand[cc.a].end(), cand[cc.b].begin(),
                           cand[cc.b].end(), std::back_inserter(both));
     std::vector<RestrictedEdge>& edges = r.circle_edges[k];
-    CircleEdges(dt, cc.circle, others, both, opt.delta, &edges);
+    CircleEdges(dt, cc, grid, both, opt.delta, &edges);
     std::vector<double> params(edges.size());
     for (size_t e = 0; e < edges.size(); ++e) params[e] = CircleParam(cc.circle, edges[e].x);
     // Sort by (v0, v1, param), keeping params parallel.
@@ -516,6 +518,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     return out;
   }
   const CollarRestriction res = ComputeCollarRestriction(dt, collars, opt, cache);
+  const SurfaceBallGrid grid(balls);
   for (uint32_t c : res.candidates_per_ball) rep.candidates += c;
   const std::vector<RestrictedTriangle>& tris = res.triangles;
   auto ball_hint = [&](uint32_t ball) {
@@ -533,11 +536,11 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     cr.collar_dim = circle == CollarRepair::kNoCircle ? 2 : 1;
     cr.reason = why;
     if (circle == CollarRepair::kNoCircle) {
-      if (!OnCollarSurface(x, ball, balls)) return;
+      if (!grid.OnSurface(x, ball)) return;
     } else {
       const CollarCircle& cc = collars.circles[circle];
       cr.ball = cc.a;
-      if (InsideAnyBall(x, OtherBalls(balls, cc.a, cc.b))) return;
+      if (grid.InsideAny(x, cc.a, cc.b)) return;
     }
     const VertexId nv = dt.NearestVertex(x, ball_hint(cr.ball));
     if (!nv.valid()) return;
@@ -660,7 +663,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       const Vec3 d = balls[bi].center - pv;
       if (!(geom::Norm(d) > 0)) continue;
       const Vec3 x = balls[bi].center + balls[bi].radius * Unit(d);
-      if (!OnCollarSurface(x, bi, balls)) continue;
+      if (!grid.OnSurface(x, bi)) continue;
       if (dt.NearestVertex(x, dt.VertexTet(VertexId(v))) != VertexId(v)) continue;
       consider(x, bi, CollarRepair::kNoCircle);
     }
@@ -725,7 +728,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       Vec3 best_x;
       for (const Vec3& d : dirs) {
         const Vec3 x = b.center + b.radius * d;
-        if (!OnCollarSurface(x, bi, balls)) continue;
+        if (!grid.OnSurface(x, bi)) continue;
         const VertexId nv = dt.NearestVertex(x, ball_hint(bi));
         const double dist = geom::Dist(x, dt.Point(nv));
         if (dist > best_d) {

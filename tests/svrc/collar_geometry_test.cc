@@ -185,6 +185,66 @@ TEST(OnCollarSurfaceTest, OtherBallsExclude) {
   EXPECT_EQ(d.circles_of_ball[1].size(), 1u);
 }
 
+// SurfaceBallGrid answers as the scans do, bit for bit: balls of radii over
+// five orders of magnitude (some far from the origin, where the box test's
+// rounding matters), queried at random points, at points constructed on
+// their spheres and on the spheres of other balls, and at points on the
+// widened box faces and cell boundaries; skipping none, one or two balls.
+TEST(SurfaceBallGridTest, AnswersAsTheScans) {
+  std::mt19937_64 rng(16);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_real_distribution<double> lr(-5, 0);
+  std::vector<CollarBall> balls;
+  for (int i = 0; i < 300; ++i) {
+    const double off = i % 7 == 0 ? 1e3 : 0;  // a cluster far out
+    balls.push_back({{off + u(rng), u(rng), u(rng)}, 0.2 * std::pow(10.0, lr(rng))});
+  }
+  // Tangent and touching pairs: a ball whose sphere passes through another's centre.
+  balls.push_back({balls[3].center + Vec3(balls[3].radius, 0, 0), balls[3].radius});
+  balls.push_back({balls[5].center + Vec3(0, 2 * balls[5].radius, 0), balls[5].radius});
+  const SurfaceBallGrid grid(balls);
+  std::vector<CollarBall> others;
+  auto check = [&](const Vec3& x, uint32_t self, uint32_t other) {
+    others.clear();
+    for (uint32_t j = 0; j < balls.size(); ++j) {
+      if (j != self && j != other) others.push_back(balls[j]);
+    }
+    ASSERT_EQ(grid.InsideAny(x, self, other), InsideAnyBall(x, others)) << x.x << " " << x.y << " " << x.z;
+    if (other == SurfaceBallGrid::kNone && self != SurfaceBallGrid::kNone) {
+      ASSERT_EQ(grid.OnSurface(x, self), OnCollarSurface(x, self, balls));
+    }
+  };
+  const uint32_t n = static_cast<uint32_t>(balls.size());
+  int inside = 0, total = 0;
+  for (int q = 0; q < 20000; ++q) {
+    const uint32_t i = static_cast<uint32_t>(rng() % n), j = static_cast<uint32_t>(rng() % n);
+    const CollarBall& b = balls[i];
+    Vec3 x;
+    switch (q % 5) {
+      case 0: x = Vec3((i % 7 == 0 ? 1e3 : 0) + u(rng), u(rng), u(rng)); break;
+      case 1: x = b.center + b.radius * RandomUnit(rng); break;  // on sphere i, rounded
+      case 2: {  // on the circle where spheres i and j meet, when they do
+        Circle3 c;
+        if (i == j || !SphereSphereCircle(b, balls[j], &c)) continue;
+        Vec3 e = geom::Cross(c.normal, RandomUnit(rng));
+        if (!(geom::Norm(e) > 1e-6)) continue;
+        x = c.center + (c.radius / geom::Norm(e)) * e;
+        break;
+      }
+      case 3: x = b.center + Vec3(b.radius * (1 + 1e-9), 0, 0); break;  // OutsideBox's own bound
+      default: x = Vec3(std::ldexp(std::round(std::ldexp(b.center.x, 6)), -6), b.center.y, b.center.z);  // a cell face
+    }
+    check(x, SurfaceBallGrid::kNone, SurfaceBallGrid::kNone);
+    check(x, i, SurfaceBallGrid::kNone);
+    check(x, i, j);
+    inside += InsideAnyBall(x, balls);
+    ++total;
+  }
+  // Both answers occur often enough to mean something.
+  EXPECT_GT(inside, total / 10);
+  EXPECT_LT(inside, total - total / 10);
+}
+
 TEST(RepresentationAngleTest, HandChecked) {
   const Vec3 o(0, 0, 0);
   EXPECT_NEAR(RepresentationAngle({0, 0, 1}, {0, 0, 2}, o), 0, 1e-16);
