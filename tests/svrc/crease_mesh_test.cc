@@ -424,6 +424,19 @@ TEST(CreaseMesh, LONG_BunnyMeshes) {
   EXPECT_GT(MeshCorpusFileAndCheck("f_real/bunny.off").tets, 1000000u);
 }
 
+// c_creases/fandisk.off in full (LONG_: ~48 min wall, 8.5 GB; session 16):
+// 4,311 of its 6,475 vertices and 209 segments are acute creases, 5,651
+// collars, 333 COLLAR rounds (the facet-crossing check restarted them four
+// times), the snap band as fallback; 7,407,634 tets. Session 8 stopped it at
+// 900 s, and with σ = 89° at a topology repair below the RepBall floor,
+// before the snap fallback (session 11) existed.
+TEST(CreaseMesh, LONG_FandiskMeshes) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  EXPECT_GT(MeshCorpusFileAndCheck("c_creases/fandisk.off").tets, 1000000u);
+}
+
 // A flat tetrahedron (base creases at 26.6°). Its (1,2) points were strictly
 // inside their vertex balls by rounding and got no balls, and consecutive
 // balls on a base edge met at a sharp angle (10 of 22 intersecting pairs
