@@ -83,7 +83,8 @@ class CancelToken {
 // is its Delaunay tetrahedralization (what `tetgen` does without -p). `progress`
 // and `cancel` may be null. Errors: INVALID_ARGUMENT (broken input, with the
 // offending ids), UNIMPLEMENTED (a feature the core does not do yet — never a
-// wrong mesh), RESOURCE_EXHAUSTED (vertex budget), CANCELLED, DEADLINE_EXCEEDED.
+// wrong mesh), RESOURCE_EXHAUSTED (vertex budget, or an allocation that
+// failed: caught, never a crash), CANCELLED, DEADLINE_EXCEEDED.
 absl::StatusOr<mesh::TetMesh> MeshPlc(const plc::Plc& plc, const MeshParams& params,
                                       const ProgressCallback& progress = nullptr,
                                       const CancelToken* cancel = nullptr);
