@@ -353,6 +353,53 @@ TEST(CollarSurfaceTest, SizeCriterion) {
   RunOne(WithBackground(Chain(), 0.4, 7), SizeMode(), "size");
 }
 
+// CollarRepairs' size test reads css(x) from the balls within 3ρ of x's own
+// ball, found through the balls sorted by centre x; it must equal
+// CollarSurfaceSize over every ball. Checked on the ratio and count it
+// reports, against a full computation, on balls of two sizes that overlap.
+TEST(CollarSurfaceTest, SizeTestReadsTheCollarSurfaceSizeOfAllBalls) {
+  // A ball of radius 1 with eight balls of radius 0.2 around its equator,
+  // centred 1.1 from its centre: next to them, css(x) on the big sphere is
+  // their term |x c_j| < 1, not the big ball's own radius.
+  Scene s;
+  s.name = "big ball + 8 small";
+  s.balls.push_back({Vec3(0, 0, 0), 1.0});
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * std::numbers::pi / 4 + 0.1;
+    s.balls.push_back({Vec3(1.1 * std::cos(a), 1.1 * std::sin(a), 0), 0.2});
+  }
+  s = WithBackground(s, 0.15, 7);
+  uint32_t next = 0;
+  const Delaunay3 dt = Build(s, &next);
+  const CollarDescription cd = BuildCollarDescription(s.balls);
+  CollarSurfaceOptions opt = SizeMode();
+  const CollarRestriction res = ComputeCollarRestriction(dt, cd, opt, nullptr);
+  // Every representation ball's radius over css(x), from all the balls.
+  std::vector<double> ratios;
+  int from_other = 0;  // triangles whose css is another ball's term
+  for (const RestrictedTriangle& t : res.triangles) {
+    const double css = CollarSurfaceSize(t.x, cd);
+    ratios.push_back(t.rep_radius / css);
+    from_other += css < s.balls[t.ball].radius;
+  }
+  for (uint32_t k = 0; k < cd.circles.size(); ++k) {
+    for (const RestrictedEdge& e : res.circle_edges[k]) {
+      ratios.push_back(geom::Dist(e.x, dt.Point(e.v[0])) / CollarSurfaceSize(e.x, cd));
+    }
+  }
+  ASSERT_GT(res.triangles.size(), 100u);
+  EXPECT_GT(from_other, static_cast<int>(res.triangles.size() / 10));
+  // ε_s at the median ratio: about half the balls fail the test.
+  std::vector<double> sorted = ratios;
+  std::sort(sorted.begin(), sorted.end());
+  opt.eps_s = sorted[sorted.size() / 2];
+  const int too_big = static_cast<int>(std::count_if(ratios.begin(), ratios.end(), [&](double r) { return r > opt.eps_s; }));
+  CollarSurfaceReport rep;
+  CollarRepairs(dt, cd, opt, &rep, nullptr);
+  EXPECT_EQ(rep.too_big, too_big);
+  EXPECT_EQ(rep.max_rep_ratio, sorted.back());
+}
+
 TEST(CollarSurfaceTest, ReportsTheViolationAndWhere) {
   // A lone centre vertex: the sphere is inside one cell, (d) fires and names a
   // sphere point; after it, the repairs are RepBall centres or circle points.
