@@ -123,6 +123,7 @@ class SurfaceBallGrid {
   std::span<const CollarBall> balls_;
   std::vector<Entry> entries_;  // sorted by (level, ix, iy, iz, ball)
   std::vector<int32_t> levels_;  // distinct levels, ascending
+  std::vector<double> inv_side_;  // 2^−level of each
 };
 
 // Definition 26: builds circles for every pair of balls whose spheres cross.
