@@ -424,7 +424,7 @@ TEST(CreaseMesh, LONG_BunnyMeshes) {
   EXPECT_GT(MeshCorpusFileAndCheck("f_real/bunny.off").tets, 1000000u);
 }
 
-// c_creases/fandisk.off in full (LONG_: ~48 min wall, 8.5 GB; session 16):
+// c_creases/fandisk.off in full (LONG_: 39 min wall, 8.5 GB; session 16):
 // 4,311 of its 6,475 vertices and 209 segments are acute creases, 5,651
 // collars, 333 COLLAR rounds (the facet-crossing check restarted them four
 // times), the snap band as fallback; 7,407,634 tets. Session 8 stopped it at
