@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <tuple>
 
 #include "core/geometry/predicates.h"
 
@@ -215,59 +214,6 @@ bool InsideAnyBall(const Vec3& p, std::span<const CollarBall> balls) {
   for (const CollarBall& b : balls) {
     if (OutsideBox(p, b)) continue;
     if (geom::InBall(p, b.center, b.radius) > 0) return true;
-  }
-  return false;
-}
-
-namespace {
-// The cell of side 2^level holding coordinate v; inv = 2^−level (the product
-// is exact: a power-of-two scale of a normal number).
-int64_t CellOf(double v, double inv) { return static_cast<int64_t>(std::floor(v * inv)); }
-}  // namespace
-
-SurfaceBallGrid::SurfaceBallGrid(std::span<const CollarBall> balls) : balls_(balls) {
-  entries_.reserve(balls.size() * 2);
-  for (uint32_t j = 0; j < balls.size(); ++j) {
-    const CollarBall& b = balls[j];
-    const Vec3& c = b.center;
-    // A double x strictly inside the ball has c − r < x < c + r, and rounding
-    // is monotone, so fl(c − r) ≤ x ≤ fl(c + r): the cells of that box hold
-    // every point InBall can call inside. 2^level > 2r: at most two cells
-    // per axis.
-    const double w = b.radius;
-    const int32_t level = std::ilogb(2 * w) + 1;
-    const double inv = std::ldexp(1.0, -level);
-    const int64_t lo[3] = {CellOf(c.x - w, inv), CellOf(c.y - w, inv), CellOf(c.z - w, inv)};
-    const int64_t hi[3] = {CellOf(c.x + w, inv), CellOf(c.y + w, inv), CellOf(c.z + w, inv)};
-    for (int64_t ix = lo[0]; ix <= hi[0]; ++ix) {
-      for (int64_t iy = lo[1]; iy <= hi[1]; ++iy) {
-        for (int64_t iz = lo[2]; iz <= hi[2]; ++iz) entries_.push_back({level, ix, iy, iz, j});
-      }
-    }
-    levels_.push_back(level);
-  }
-  auto key = [](const Entry& e) { return std::tuple(e.level, e.ix, e.iy, e.iz, e.ball); };
-  std::sort(entries_.begin(), entries_.end(), [&](const Entry& a, const Entry& b) { return key(a) < key(b); });
-  std::sort(levels_.begin(), levels_.end());
-  levels_.erase(std::unique(levels_.begin(), levels_.end()), levels_.end());
-  for (const int32_t level : levels_) inv_side_.push_back(std::ldexp(1.0, -level));
-}
-
-bool SurfaceBallGrid::InsideAny(const Vec3& p, uint32_t skip_a, uint32_t skip_b) const {
-  for (size_t li = 0; li < levels_.size(); ++li) {
-    const int32_t level = levels_[li];
-    const double inv = inv_side_[li];
-    const Entry probe{level, CellOf(p.x, inv), CellOf(p.y, inv), CellOf(p.z, inv), 0};
-    auto cell = [](const Entry& e) { return std::tuple(e.level, e.ix, e.iy, e.iz); };
-    auto it = std::lower_bound(entries_.begin(), entries_.end(), probe,
-                               [&](const Entry& a, const Entry& b) { return cell(a) < cell(b); });
-    for (; it != entries_.end() && cell(*it) == cell(probe); ++it) {
-      const uint32_t j = it->ball;
-      if (j == skip_a || j == skip_b) continue;
-      const CollarBall& b = balls_[j];
-      if (OutsideBox(p, b)) continue;
-      if (geom::InBall(p, b.center, b.radius) > 0) return true;
-    }
   }
   return false;
 }

@@ -97,35 +97,6 @@ bool OnCollarSurface(const Vec3& x, uint32_t self, std::span<const CollarBall> b
 // True iff p is strictly inside some ball of `balls` (exact, InBall).
 bool InsideAnyBall(const Vec3& p, std::span<const CollarBall> balls);
 
-// The same decisions as OnCollarSurface / InsideAnyBall over one list of
-// balls, without scanning it: each ball is filed in the ≤ 8 cells of side
-// 2^L > 2·radius that its rounded bounding box meets, per level L; a query
-// reads the cell holding the point at each level. Every ball that holds the
-// point strictly inside is found (collar_geometry.cc), and the exact InBall
-// decides, so the answers are those of the scans bit for bit (the order of
-// the balls does not matter to "any"). The scans were 22% of a fandisk.off
-// run's samples (5,651 balls, one scan per root and repair).
-class SurfaceBallGrid {
- public:
-  static constexpr uint32_t kNone = 0xFFFFFFFFu;
-  explicit SurfaceBallGrid(std::span<const CollarBall> balls);
-  // True iff p is strictly inside a ball other than `skip_a` and `skip_b`.
-  bool InsideAny(const Vec3& p, uint32_t skip_a = kNone, uint32_t skip_b = kNone) const;
-  // OnCollarSurface(x, self, balls).
-  bool OnSurface(const Vec3& x, uint32_t self) const { return !InsideAny(x, self); }
-
- private:
-  struct Entry {
-    int32_t level;
-    int64_t ix, iy, iz;
-    uint32_t ball;
-  };
-  std::span<const CollarBall> balls_;
-  std::vector<Entry> entries_;  // sorted by (level, ix, iy, iz, ball)
-  std::vector<int32_t> levels_;  // distinct levels, ascending
-  std::vector<double> inv_side_;  // 2^−level of each
-};
-
 // Definition 26: builds circles for every pair of balls whose spheres cross.
 // O(n²) pairs; the refiner builds the same incrementally from BLG neighbours.
 CollarDescription BuildCollarDescription(std::span<const CollarBall> balls);

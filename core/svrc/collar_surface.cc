@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/geometry/predicates.h"
+#include "core/svrc/ball_grid.h"
 
 namespace svrc::refine {
 
@@ -107,7 +108,7 @@ std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b
 // which therefore meet the ball). Same constructions as
 // RestrictedSphereTriangles; the angle uses each vertex snapped to this
 // sphere (Snap, §3.1.2).
-void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, const SurfaceBallGrid& grid, uint32_t ball,
+void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, const BallGrid& grid, uint32_t ball,
                      std::span<const uint32_t> cand, const std::vector<uint8_t>& is_cand,
                      double delta, std::vector<RestrictedTriangle>* out) {
   const CollarBall& b = balls[ball];
@@ -153,7 +154,7 @@ void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, con
         int kept = 0;
         for (int k = 0; k < nr; ++k) {
           const Vec3 x = ct + s[k] * (end - ct);
-          if (!grid.OnSurface(x, ball)) continue;
+          if (grid.StrictlyInside(x, ball)) continue;
           const double ang = RepresentationAngle(nrm, x, b.center);
           if (kept == 0 || ang > rt.angle) {
             rt.x = x;
@@ -204,7 +205,7 @@ std::vector<CollarBall> OtherBalls(std::span<const CollarBall> balls, uint32_t a
 // Restricted edges of one circle among Delaunay edges with both ends in
 // `both` (candidates of both of its balls). Same construction and
 // nearest-vertex acceptance as RestrictedCircleEdges.
-void CircleEdges(const Delaunay3& dt, const CollarCircle& cc, const SurfaceBallGrid& grid,
+void CircleEdges(const Delaunay3& dt, const CollarCircle& cc, const BallGrid& grid,
                  std::span<const uint32_t> both, double delta, std::vector<RestrictedEdge>* out) {
   const Circle3& circle = cc.circle;
   Vec3 u, w;
@@ -228,7 +229,7 @@ void CircleEdges(const Delaunay3& dt, const CollarCircle& cc, const SurfaceBallG
       const double phi = std::atan2(B, A), half = std::acos(D / amp);
       for (double t : {phi - half, phi + half}) {
         const Vec3 x = circle.center + circle.radius * (std::cos(t) * u + std::sin(t) * w);
-        if (grid.InsideAny(x, cc.a, cc.b)) continue;
+        if (grid.StrictlyInside(x, cc.a, cc.b)) continue;
         // Most roots of the bisector plane are not on the Voronoi facet of
         // (a, b): a neighbour w of a or b nearer to x than both by a margin
         // shows it, and then the nearest vertex is nearer still, neither a
@@ -387,7 +388,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   CollarRestriction r;
   const std::span<const CollarBall> balls(collars.balls);
   const size_t nb = balls.size(), nc = collars.circles.size();
-  const SurfaceBallGrid grid(balls);
+  const BallGrid grid(balls);
   r.candidates_per_ball.assign(nb, 0);
   r.circle_edges.resize(nc);
   r.circle_params.resize(nc);
@@ -538,7 +539,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     return out;
   }
   const CollarRestriction res = ComputeCollarRestriction(dt, collars, opt, cache);
-  const SurfaceBallGrid grid(balls);
+  const BallGrid grid(balls);
   for (uint32_t c : res.candidates_per_ball) rep.candidates += c;
   const std::vector<RestrictedTriangle>& tris = res.triangles;
   auto ball_hint = [&](uint32_t ball) {
@@ -556,11 +557,11 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     cr.collar_dim = circle == CollarRepair::kNoCircle ? 2 : 1;
     cr.reason = why;
     if (circle == CollarRepair::kNoCircle) {
-      if (!grid.OnSurface(x, ball)) return;
+      if (grid.StrictlyInside(x, ball)) return;
     } else {
       const CollarCircle& cc = collars.circles[circle];
       cr.ball = cc.a;
-      if (grid.InsideAny(x, cc.a, cc.b)) return;
+      if (grid.StrictlyInside(x, cc.a, cc.b)) return;
     }
     const VertexId nv = dt.NearestVertex(x, ball_hint(cr.ball));
     if (!nv.valid()) return;
@@ -684,7 +685,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       const Vec3 d = balls[bi].center - pv;
       if (!(geom::Norm(d) > 0)) continue;
       const Vec3 x = balls[bi].center + balls[bi].radius * Unit(d);
-      if (!grid.OnSurface(x, bi)) continue;
+      if (grid.StrictlyInside(x, bi)) continue;
       if (dt.NearestVertex(x, dt.VertexTet(VertexId(v))) != VertexId(v)) continue;
       consider(x, bi, CollarRepair::kNoCircle);
     }
@@ -750,7 +751,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       Vec3 best_x;
       for (const Vec3& d : dirs) {
         const Vec3 x = b.center + b.radius * d;
-        if (!grid.OnSurface(x, bi)) continue;
+        if (grid.StrictlyInside(x, bi)) continue;
         const VertexId nv = dt.NearestVertex(x, ball_hint(bi));
         const double dist = geom::Dist(x, dt.Point(nv));
         if (dist > best_d) {

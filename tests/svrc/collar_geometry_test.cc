@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/geometry/predicates.h"
+#include "core/svrc/ball_grid.h"
 #include "gtest/gtest.h"
 
 namespace svrc::refine {
@@ -185,12 +186,12 @@ TEST(OnCollarSurfaceTest, OtherBallsExclude) {
   EXPECT_EQ(d.circles_of_ball[1].size(), 1u);
 }
 
-// SurfaceBallGrid answers as the scans do, bit for bit: balls of radii over
+// BallGrid answers as the scans do, bit for bit: balls of radii over
 // five orders of magnitude (some far from the origin, where the box test's
 // rounding matters), queried at random points, at points constructed on
 // their spheres and on the spheres of other balls, and at points on the
 // widened box faces and cell boundaries; skipping none, one or two balls.
-TEST(SurfaceBallGridTest, AnswersAsTheScans) {
+TEST(BallGridTest, AnswersAsTheScans) {
   std::mt19937_64 rng(16);
   std::uniform_real_distribution<double> u(-1, 1);
   std::uniform_real_distribution<double> lr(-5, 0);
@@ -202,16 +203,16 @@ TEST(SurfaceBallGridTest, AnswersAsTheScans) {
   // Tangent and touching pairs: a ball whose sphere passes through another's centre.
   balls.push_back({balls[3].center + Vec3(balls[3].radius, 0, 0), balls[3].radius});
   balls.push_back({balls[5].center + Vec3(0, 2 * balls[5].radius, 0), balls[5].radius});
-  const SurfaceBallGrid grid(balls);
+  const BallGrid grid(balls);
   std::vector<CollarBall> others;
   auto check = [&](const Vec3& x, uint32_t self, uint32_t other) {
     others.clear();
     for (uint32_t j = 0; j < balls.size(); ++j) {
       if (j != self && j != other) others.push_back(balls[j]);
     }
-    ASSERT_EQ(grid.InsideAny(x, self, other), InsideAnyBall(x, others)) << x.x << " " << x.y << " " << x.z;
-    if (other == SurfaceBallGrid::kNone && self != SurfaceBallGrid::kNone) {
-      ASSERT_EQ(grid.OnSurface(x, self), OnCollarSurface(x, self, balls));
+    ASSERT_EQ(grid.StrictlyInside(x, self, other), InsideAnyBall(x, others)) << x.x << " " << x.y << " " << x.z;
+    if (other == BallGrid::kNone && self != BallGrid::kNone) {
+      ASSERT_EQ(!grid.StrictlyInside(x, self), OnCollarSurface(x, self, balls));
     }
   };
   const uint32_t n = static_cast<uint32_t>(balls.size());
@@ -234,8 +235,8 @@ TEST(SurfaceBallGridTest, AnswersAsTheScans) {
       case 3: x = b.center + Vec3(b.radius * (1 + 1e-9), 0, 0); break;  // OutsideBox's own bound
       default: x = Vec3(std::ldexp(std::round(std::ldexp(b.center.x, 6)), -6), b.center.y, b.center.z);  // a cell face
     }
-    check(x, SurfaceBallGrid::kNone, SurfaceBallGrid::kNone);
-    check(x, i, SurfaceBallGrid::kNone);
+    check(x, BallGrid::kNone, BallGrid::kNone);
+    check(x, i, BallGrid::kNone);
     check(x, i, j);
     inside += InsideAnyBall(x, balls);
     ++total;
