@@ -4,7 +4,8 @@
 // each run in a fresh child process (this binary re-executed with --one) so
 // that its peak RSS is its own. Per run: output tets, wall and CPU time per
 // output tet, "Voronoi cells plus location-graph links touched per insertion"
-// = (RefineStats::destroy_cells_visited + links_added + links_removed) /
+// = (RefineStats::destroy_cells_visited + destroy_index_visited (the nodes and
+// points of the pending-point index Destroy reads) + links_added + links_removed) /
 // insertions, peak RSS bytes per output tet; per series whether each stays
 // within 1.5× over the runs with ≥ 10^4 output tets (the criterion).
 //
@@ -60,52 +61,70 @@
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
 
-// Heap accounting of this process: every operator new/delete goes through
-// malloc, and the bytes malloc hands out (malloc_usable_size) are counted, with
-// their high-water mark. "peak heap" is that mark during one run minus the
-// bytes live at its start: the data structures' own bytes, without the code
-// pages, libraries and allocator slack that RSS also holds (a run of 10^4 tets
-// peaks at ~14 MB RSS above its start, so a few MB of those shift its ratio).
+// Heap accounting of this process: malloc, calloc, realloc, the aligned
+// allocators and free are interposed here (glibc's __libc_* entry points do
+// the work), so every byte the run allocates is counted — operator new and
+// aligned new go through them, and so does util::PodVector's realloc — as
+// malloc_usable_size, with the high-water mark. "peak heap" is that mark
+// during one run minus the bytes live at its start: the data structures' own
+// bytes, without the code pages, libraries and allocator slack that RSS also
+// holds (a run of 10^4 tets peaks at ~14 MB RSS above its start, so a few MB
+// of those shift its ratio). A realloc counts its growth only: glibc grows
+// large blocks with mremap, without a second copy (sessions before 17
+// counted operator new alone, and aligned new not at all).
+extern "C" {
+void* __libc_malloc(size_t);
+void* __libc_calloc(size_t, size_t);
+void* __libc_realloc(void*, size_t);
+void* __libc_memalign(size_t, size_t);
+void __libc_free(void*);
+}
 namespace {
 std::atomic<int64_t> g_heap_now{0};
 std::atomic<int64_t> g_heap_peak{0};
-void* CountedAlloc(size_t n) {
-  void* p = std::malloc(n == 0 ? 1 : n);
-  if (p == nullptr) throw std::bad_alloc();
-  const int64_t size = static_cast<int64_t>(malloc_usable_size(p));
-  const int64_t now = g_heap_now.fetch_add(size, std::memory_order_relaxed) + size;
+void CountDelta(int64_t delta) {
+  const int64_t now = g_heap_now.fetch_add(delta, std::memory_order_relaxed) + delta;
   int64_t peak = g_heap_peak.load(std::memory_order_relaxed);
   while (now > peak && !g_heap_peak.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
   }
-  return p;
 }
-void CountedFree(void* p) {
-  if (p == nullptr) return;
-  g_heap_now.fetch_sub(static_cast<int64_t>(malloc_usable_size(p)), std::memory_order_relaxed);
-  std::free(p);
-}
+int64_t Usable(void* p) { return p == nullptr ? 0 : static_cast<int64_t>(malloc_usable_size(p)); }
 }  // namespace
 
-void* operator new(size_t n) { return CountedAlloc(n); }
-void* operator new[](size_t n) { return CountedAlloc(n); }
-void* operator new(size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return CountedAlloc(n);
-  } catch (...) {
-    return nullptr;
-  }
+extern "C" {
+void* malloc(size_t n) {
+  void* p = __libc_malloc(n);
+  CountDelta(Usable(p));
+  return p;
 }
-void* operator new[](size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return CountedAlloc(n);
-  } catch (...) {
-    return nullptr;
-  }
+void* calloc(size_t n, size_t size) {
+  void* p = __libc_calloc(n, size);
+  CountDelta(Usable(p));
+  return p;
 }
-void operator delete(void* p) noexcept { CountedFree(p); }
-void operator delete[](void* p) noexcept { CountedFree(p); }
-void operator delete(void* p, size_t) noexcept { CountedFree(p); }
-void operator delete[](void* p, size_t) noexcept { CountedFree(p); }
+void* realloc(void* old, size_t n) {
+  const int64_t before = Usable(old);
+  void* p = __libc_realloc(old, n);
+  if (p != nullptr || n == 0) CountDelta(Usable(p) - before);
+  return p;
+}
+void* memalign(size_t align, size_t n) {
+  void* p = __libc_memalign(align, n);
+  CountDelta(Usable(p));
+  return p;
+}
+void* aligned_alloc(size_t align, size_t n) { return memalign(align, n); }
+int posix_memalign(void** out, size_t align, size_t n) {
+  void* p = memalign(align, n);
+  if (p == nullptr) return ENOMEM;
+  *out = p;
+  return 0;
+}
+void free(void* p) {
+  CountDelta(-Usable(p));
+  __libc_free(p);
+}
+}
 
 namespace svrc::bench {
 namespace {
@@ -224,13 +243,14 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   }
   std::printf(
       "RESULT status=OK out_vertices=%zu out_tets=%zu omega_vertices=%llu omega_tets=%zu "
-      "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu links_added=%llu "
+      "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu destroy_index=%llu links_added=%llu "
       "links_removed=%llu warps=%llu yields=%llu max_degree=%u "
       "wall_prepare=%.6f wall_refine=%.6f wall_output=%.6f cpu_prepare=%.6f cpu_refine=%.6f cpu_output=%.6f "
       "base_kib=%ld peak_kib=%ld heap_peak=%lld max_re=%.6g min_dih=%.6g verify=%s\n",
       m.positions.size(), m.tets.size(), (unsigned long long)s.vertices, refined->tets.size(),
       (unsigned long long)s.segment_vertices, (unsigned long long)s.facet_vertices,
       (unsigned long long)s.insertions, (unsigned long long)s.destroy_cells_visited,
+      (unsigned long long)s.destroy_index_visited,
       (unsigned long long)s.links_added, (unsigned long long)s.links_removed, (unsigned long long)s.warps,
       (unsigned long long)s.yields, s.max_degree, w1 - w0, w2 - w1, w3 - w2, c1 - c0, c2 - c1, c3 - c2,
       base_kib, peak_kib, static_cast<long long>(heap_peak), q.all.radius_edge.max, q.all.dihedral_deg.min, verified.c_str());
@@ -388,7 +408,7 @@ Row Measure(const std::string& series, const std::string& param, const std::vect
   row.cpu = r.D("cpu_prepare") + r.D("cpu_refine") + r.D("cpu_output");
   row.wall = r.D("wall_prepare") + r.D("wall_refine") + r.D("wall_output");
   const double ins = r.D("insertions");
-  const double cells = r.D("destroy_cells"), links = r.D("links_added") + r.D("links_removed");
+  const double cells = r.D("destroy_cells") + r.D("destroy_index"), links = r.D("links_added") + r.D("links_removed");
   row.touched = (cells + links) / ins;
   row.peak_b = r.D("peak_kib") * 1024.0 / row.tets;
   row.alloc_b = (r.D("peak_kib") - r.D("base_kib")) * 1024.0 / row.tets;

@@ -29,6 +29,7 @@
 
 #include "absl/status/status.h"
 #include "core/geometry/vec3.h"
+#include "core/util/pod_vector.h"
 
 namespace svrc::delaunay {
 
@@ -280,8 +281,8 @@ class Delaunay3 {
   // Tets.
   // Index in tets_ of the neighbour slot named by the encoding 4t+f.
   static constexpr uint32_t NRef(uint32_t n) { return 8 * (n >> 2) + 4 + (n & 3); }
-  std::vector<uint32_t> tets_;  // per tet: 4 vertices then 4 neighbours (one cache line per 2 tets)
-  std::vector<uint32_t> tet_gen_;
+  util::PodVector<uint32_t> tets_;  // per tet: 4 vertices then 4 neighbours (one cache line per 2 tets)
+  util::PodVector<uint32_t> tet_gen_;
   uint32_t free_head_ = kFreeSlot;
   uint32_t num_live_tets_ = 0;
   uint32_t num_ghost_tets_ = 0;

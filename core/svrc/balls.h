@@ -13,6 +13,7 @@
 #include "core/geometry/vec3.h"
 #include "core/svrc/containment.h"
 #include "core/svrc/ids.h"
+#include "core/util/pod_vector.h"
 
 namespace svrc::refine {
 
@@ -101,7 +102,7 @@ class BallStore {
     uint8_t encroach_queued = 0;
   };
   static_assert(sizeof(Record) == 64);
-  std::vector<Record> rec_;
+  util::PodVector<Record> rec_;
   std::vector<MeshId> mesh_;  // rarely read
   uint32_t num_alive_ = 0;
 };

@@ -15,6 +15,7 @@
 #include "core/geometry/vec3.h"
 #include "core/svrc/ids.h"
 #include "core/svrc/work_queue.h"
+#include "core/util/pod_vector.h"
 
 namespace svrc::refine {
 
@@ -88,7 +89,7 @@ class OmegaMesh {
   CellSize Size(VertexId v) const;
   // Tet labels for CellSize's kept_* fields (nullptr: none; every tet
   // counts as kept). Drops every memo of Size().
-  void SetLabels(const std::vector<TetLabel>* labels) {
+  void SetLabels(const util::PodVector<TetLabel>* labels) {
     labels_ = labels;
     size_memo_.clear();
   }
@@ -192,7 +193,7 @@ class OmegaMesh {
   std::vector<EventHandle> skinny_event_;
   std::vector<EventHandle> unresolved_event_;
   mutable Stats stats_;
-  mutable std::vector<CcEntry> cc_;
+  mutable util::PodVector<CcEntry> cc_;
   // Size() per vertex, valid while the vertex's star is unchanged
   // (Delaunay3::StarVersion): the event loop asks again for cells that did
   // not change (IsLive, Output, invariant checks).
@@ -203,8 +204,8 @@ class OmegaMesh {
     uint32_t kept_hint_gen = 0;  // Generation(size.kept_hint) when computed
     Uniqueness unique;
   };
-  mutable std::vector<SizeMemo> size_memo_;
-  const std::vector<TetLabel>* labels_ = nullptr;
+  mutable util::PodVector<SizeMemo> size_memo_;
+  const util::PodVector<TetLabel>* labels_ = nullptr;
   // Scratch.
   mutable std::vector<geom::Vec3> poly_, poly2_;
 };

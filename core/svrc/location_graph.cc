@@ -95,7 +95,7 @@ void LocationGraph::CompactIfSparse(Arena<Entry>& arena, std::vector<Span*>& spa
 
 void LocationGraph::MaybeCompactCells() {
   std::vector<Span*> spans;
-  for (std::vector<CellSpanT>& mesh_spans : cell_spans_) {
+  for (util::PodVector<CellSpanT>& mesh_spans : cell_spans_) {
     for (CellSpanT& s : mesh_spans) {
       if (s.cap != 0) spans.push_back(&s);
     }
@@ -118,7 +118,7 @@ inline LocationGraph::CellSpanT& LocationGraph::CellSpan(MeshId mesh, uint32_t c
     return cell_spans_[mesh.value()][cell];
   }
   if (cell_spans_.size() <= mesh.value()) cell_spans_.resize(mesh.value() + 1);
-  std::vector<CellSpanT>& spans = cell_spans_[mesh.value()];
+  util::PodVector<CellSpanT>& spans = cell_spans_[mesh.value()];
   if (spans.size() <= cell) {
     util::ReserveForAppend(spans, cell + 1 - spans.size());
     spans.resize(cell + 1);

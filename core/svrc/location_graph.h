@@ -22,6 +22,7 @@
 
 #include "core/svrc/balls.h"
 #include "core/svrc/ids.h"
+#include "core/util/pod_vector.h"
 
 namespace svrc::refine {
 
@@ -184,7 +185,7 @@ class LocationGraph {
     uint64_t PoolSize() const { return pool_.size(); }
 
    private:
-    std::vector<Entry> pool_;
+    util::PodVector<Entry> pool_;
     std::vector<uint32_t> free_[32];  // [log2 cap] offsets of free blocks
   };
 
@@ -236,7 +237,7 @@ class LocationGraph {
   Arena<CellEntry> cell_arena_;
   Arena<ObjectEntry> object_arena_;
   uint32_t num_links_ = 0;
-  std::vector<std::vector<CellSpanT>> cell_spans_;  // [mesh][cell]
+  std::vector<util::PodVector<CellSpanT>> cell_spans_;  // [mesh][cell]
   std::vector<std::vector<uint32_t>> unresolved_cells_;  // [mesh]: cells with unresolved > 0
   std::vector<Span> ball_spans_;
   std::vector<Span> collar_spans_;

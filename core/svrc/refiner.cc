@@ -35,6 +35,7 @@
 #include "core/util/grow.h"
 #include "core/svrc/labelling.h"
 #include "core/svrc/location_graph.h"
+#include "core/svrc/pending_points.h"
 #include "core/svrc/normalize.h"
 #include "core/svrc/points.h"
 #include "core/svrc/work_queue.h"
@@ -99,7 +100,7 @@ double LongestEdgeCubed(const std::array<Vec3, 4>& x) {
 class Refiner {
  public:
   Refiner(const RefineOptions& options, Normalization norm, const Vec3& center, double half)
-      : options_(options), norm_(norm), omega_(center, half), collar_snap_(options.collar_snap) {}
+      : options_(options), norm_(norm), omega_(center, half), pending_(center, half), collar_snap_(options.collar_snap) {}
 
   absl::Status Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments);
   // Shared by both entry points: the complex's points are `normalised` (global
@@ -500,6 +501,23 @@ class Refiner {
   LocationGraph blg_;
   WorkQueues queues_;
   OmegaMesh omega_;
+  // The points of the 0-balls linked unresolved into M_Ω (LinkVertexBallToOmega),
+  // erased when their point enters M_Ω; entries that became suppressed are
+  // erased when a query meets them. in_pending_: per ball.
+  PendingPoints pending_;
+  std::vector<uint8_t> in_pending_;
+  std::vector<uint32_t> near_pending_;  // scratch
+  void AddPending(BallId b) {
+    if (in_pending_.size() <= b.value()) in_pending_.resize(b.value() + b.value() / 4 + 64, 0);
+    if (in_pending_[b.value()]) return;
+    in_pending_[b.value()] = 1;
+    pending_.Insert(b.value(), balls_.Center(b));
+  }
+  void ErasePending(BallId b) {
+    if (b.value() >= in_pending_.size() || !in_pending_[b.value()]) return;
+    in_pending_[b.value()] = 0;
+    pending_.Erase(b.value(), balls_.Center(b));
+  }
   std::vector<SegmentMesh> segs_;
   uint32_t seg_mesh0_ = 0;  // MeshId of segment 0 (= its FeatureId)
   std::vector<uint32_t> seg_input_a_;  // input endpoint at t = 0 of each segment
@@ -529,7 +547,7 @@ class Refiner {
   std::vector<double> size_target_;  // per M_Ω vertex: max R_v from max_volume (+inf: none)
   // Per M_Ω tet slot (TetLabel): set by SetSizeTargets' labelling, carried
   // to new tets by PropagateSizeTargets; empty while M_Ω is not labelled.
-  std::vector<TetLabel> tet_labels_;
+  util::PodVector<TetLabel> tet_labels_;
   void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
   std::vector<TetLabel> created_labels_;  // scratch
   // Collars (stage (d)).
@@ -648,7 +666,7 @@ class Refiner {
     bool valid = false;
     bool exterior = false;  // every star tet outside the output at the last Size() (§8 item 33)
   };
-  std::vector<CellCert> cell_cert_;
+  util::PodVector<CellCert> cell_cert_;
   std::vector<TetId> created_;
   std::vector<OmegaMesh::NewTets> new_at_;  // per cell of 𝒱: what the insertion added to its star
   std::vector<uint32_t> cert_mark_, cert_pos_;
@@ -1020,6 +1038,7 @@ void Refiner::LinkBallToOmega(BallId b, VertexId start) {
 
 void Refiner::LinkVertexBallToOmega(BallId b, VertexId start) {
   if (Suppressed(balls_.VertexPoint(b))) return;
+  AddPending(b);
   const delaunay::Delaunay3& dt = omega_.dt();
   const VertexId cell = dt.NearestVertex(balls_.Center(b), dt.VertexTet(start));
   LinkFacts facts;
@@ -1387,7 +1406,25 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     // the CPU of cube.poly --max-volume 1e-5 before session 9; the output is
     // byte-identical).
     const std::vector<uint32_t>& unresolved_cells = blg_.UnresolvedCells(kOmegaMesh);
-    if (unresolved_cells.size() <= options_.local_destroy_cells) {
+    if (options_.destroy_index) {
+      // §8 item 41: v's balls and the pending points within θr of c, which
+      // are exactly the warp targets the cells would give (a 0-ball linked
+      // unresolved into M_Ω and not yet in it is in the index; the index's
+      // other entries, resolved or suppressed since, fail line 4's tests
+      // below as they would in a cell, and are erased here).
+      bfs_.assign(1, v);
+      ++stats_.destroys_local;
+      near_pending_.clear();
+      stats_.destroy_index_visited += pending_.Near(c, options_.theta * r, &near_pending_);
+      CollectBalls(&gathered_, [&](const auto& add) {
+        blg_.ForEachBall(kOmegaMesh, v.value(), add);
+        for (uint32_t id : near_pending_) add(BallId(id));
+      });
+      for (uint32_t id : near_pending_) {
+        const PointId q = balls_.VertexPoint(BallId(id));
+        if (points_.InMesh(q, kOmegaMesh) || Suppressed(q)) ErasePending(BallId(id));
+      }
+    } else if (unresolved_cells.size() <= options_.local_destroy_cells) {
       bfs_.assign(1, v);
       for (uint32_t u : unresolved_cells) {
         if (u != v.value()) bfs_.push_back(VertexId(u));
@@ -1403,7 +1440,9 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     // guide §3). Line 9: 𝒴 = lower-CD balls with c strictly inside.
     BallId warp, yield;
     double warp_d2 = 0;
-    if (options_.destroy_gather_all) {
+    if (options_.destroy_index) {
+      // gathered_ is filled above.
+    } else if (options_.destroy_gather_all) {
       GatherBalls(kOmegaMesh, bfs_, &gathered_);
     } else {
       GatherDestroyBalls(v, bfs_, &gathered_);
@@ -1491,7 +1530,10 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   points_.SetVertex(p, kOmegaMesh, nv.value());
   // The point's own 0-ball is resolved in M_Ω: drop its links there.
   const BallId own = VertexBallOf(p);
-  if (own.valid()) blg_.RemoveObjectLinks(LocationObject::Ball(own), kOmegaMesh, nullptr);
+  if (own.valid()) {
+    blg_.RemoveObjectLinks(LocationObject::Ball(own), kOmegaMesh, nullptr);
+    ErasePending(own);
+  }
   // 𝒱 = cavity vertices, 𝒱' = 𝒱 ∪ {p}. Copy: the span points into Delaunay3
   // scratch, which later queries reuse.
   std::vector<VertexId>& changed = insert_changed_;
@@ -3357,6 +3399,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.sizes_clipped", static_cast<double>(clipped_cells));
   out->Set("svrc.destroys_local", static_cast<double>(destroys_local));
   out->Set("svrc.destroy_cells_visited", static_cast<double>(destroy_cells_visited));
+  out->Set("svrc.destroy_index_visited", static_cast<double>(destroy_index_visited));
   out->Set("svrc.max_destroy_cells", static_cast<double>(max_destroy_cells));
   out->Set("svrc.destroy_balls_read", static_cast<double>(destroy_balls_read));
   out->Set("svrc.warps", static_cast<double>(warps));

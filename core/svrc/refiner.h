@@ -76,6 +76,11 @@ struct RefineOptions {
   // cell meeting B). docs/svrc-design.md §8 item 40; 0 searches whenever any
   // cell holds one (tests).
   uint32_t local_destroy_cells = 256;
+  // Destroy in M_Ω takes its warp targets from an index of the unresolved
+  // 0-balls' points (PendingPoints: those within θr of c) and its yields from
+  // v's links, never reading other cells (the same choices: §8 item 41);
+  // false: the cells above (tests).
+  bool destroy_index = true;
   // UpdateLocation drops a shrunk cell's link to a lower ball that lies
   // wholly beyond the bisector of the cell's vertex and the new point, and
   // links the new cell's balls in ball-id order (docs/svrc-design.md §8 item
@@ -238,6 +243,7 @@ struct RefineStats {
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
   uint64_t destroy_cells_visited = 0;  // |𝒱| summed over Destroy calls
+  uint64_t destroy_index_visited = 0;  // PendingPoints nodes and points read by Destroy (destroy_index)
   uint64_t destroy_balls_read = 0;     // balls Destroy in M_Ω tested for a warp or a yield
   uint64_t destroys_local = 0;     // Destroy in M_Ω without the search of cells meeting B (local_destroy_cells)
   uint64_t max_destroy_cells = 0;

@@ -406,7 +406,10 @@ TEST(CollarRefine, DestroyReadsWhatItNeedsWithTheSameRefinement) {
         SameRefinementCase{"b_internal/box_in_box.poly", false, 0},
         SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 0}}) {
     if (kSanitized && c.collars) continue;  // seconds in release, a minute under ASan; the others cover the code
-    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->destroy_gather_all = !on; });
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
+      o->destroy_index = false;  // the cells' modes
+      o->destroy_gather_all = !on;
+    });
     EXPECT_EQ(runs[0].stats.warps, runs[1].stats.warps) << c.rel;
     EXPECT_EQ(runs[0].stats.yields, runs[1].stats.yields) << c.rel;
     EXPECT_LT(runs[1].stats.destroy_balls_read, runs[0].stats.destroy_balls_read) << c.rel;
@@ -427,12 +430,47 @@ TEST(CollarRefine, LocalDestroyMakesTheSameRefinement) {
         SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
         SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 0}}) {
     if (kSanitized && c.collars) continue;
-    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->local_destroy_cells = on ? 256 : 0; });
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
+      o->destroy_index = false;  // the cells' modes
+      o->local_destroy_cells = on ? 256 : 0;
+    });
     EXPECT_EQ(runs[0].stats.warps, runs[1].stats.warps) << c.rel;
     EXPECT_EQ(runs[0].stats.yields, runs[1].stats.yields) << c.rel;
     EXPECT_GT(runs[1].stats.destroys_local, runs[0].stats.destroys_local) << c.rel;
     std::printf("%s: %llu of the Destroys local, %llu with the search whenever a cell holds an unresolved point\n",
                 c.rel, (unsigned long long)runs[1].stats.destroys_local, (unsigned long long)runs[0].stats.destroys_local);
+  }
+}
+
+// Destroy's warp targets from the index of pending points (RefineOptions::
+// destroy_index, §8 item 41) instead of the cells: the 0-balls linked
+// unresolved into M_Ω are indexed by position, and those within θr of c are
+// the targets the cells meeting B would give. Bit-identical refinements
+// against the search of the cells meeting B on every Destroy, including the
+// collar path (knife_edge, segment_fan), where points become suppressed after
+// they were indexed. An index missing a target (a 0-ball linked without
+// being indexed, a query that misses the points in a neighbouring octant)
+// changes the refinement here.
+TEST(CollarRefine, IndexedDestroyMakesTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"c_creases/knife_edge.poly", true, 0}, SameRefinementCase{"d_small_angles/segment_fan.poly", true, 0},
+        SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
+        SameRefinementCase{"b_internal/box_in_box.poly", false, 0},
+        SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 0}}) {
+    if (kSanitized && c.collars) continue;
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
+      o->destroy_index = on;
+      o->local_destroy_cells = 0;  // off: the search on every Destroy
+    });
+    EXPECT_EQ(runs[0].stats.warps, runs[1].stats.warps) << c.rel;
+    EXPECT_EQ(runs[0].stats.yields, runs[1].stats.yields) << c.rel;
+    EXPECT_GT(runs[0].stats.warps, 0u) << c.rel;
+    EXPECT_GT(runs[1].stats.destroy_index_visited, 0u) << c.rel;
+    std::printf("%s: %llu warps; Destroy read %llu cells with the search, %llu cells and %llu index nodes/points "
+                "with the index\n",
+                c.rel, (unsigned long long)runs[1].stats.warps, (unsigned long long)runs[0].stats.destroy_cells_visited,
+                (unsigned long long)runs[1].stats.destroy_cells_visited,
+                (unsigned long long)runs[1].stats.destroy_index_visited);
   }
 }
 

@@ -32,7 +32,7 @@ struct Counts {
 // and the kept_* fields are compared too.
 Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool labelled = false) {
   OmegaMesh a(Vec3{0.5, 0.5, 0.5}, 2.0), b(Vec3{0.5, 0.5, 0.5}, 2.0);
-  std::vector<TetLabel> labels;
+  util::PodVector<TetLabel> labels;
   if (labelled) {
     a.SetLabels(&labels);
     b.SetLabels(&labels);
