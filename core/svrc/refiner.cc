@@ -2674,12 +2674,15 @@ absl::Status Refiner::StitchImpl() {
     if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.emplace_back(f.where, f.ball);
   }
   if (!r.ok()) return r.status();
-  stitch_report_ = *r;
-  stitched_.clear();
-  for (const auto& t : r->tets) {
-    stitched_.push_back({omega_.PointOf(VertexId(t[0])).value(), omega_.PointOf(VertexId(t[1])).value(),
-                         omega_.PointOf(VertexId(t[2])).value(), omega_.PointOf(VertexId(t[3])).value()});
+  // The tets to point ids in place, then moved: stitched_ grown by push_back
+  // beside r->tets held both, and a doubling vector's old block at its last
+  // growth (268 MB of bunny.off's stitch).
+  std::vector<std::array<uint32_t, 4>> tets = std::move(r->tets);
+  for (auto& t : tets) {
+    for (uint32_t& v : t) v = omega_.PointOf(VertexId(v)).value();
   }
+  stitch_report_ = *std::move(r);
+  stitched_ = std::move(tets);
   stitched_done_ = true;
   return absl::OkStatus();
 }
@@ -3301,10 +3304,13 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   out.input_vertex.resize(num_input_);
   for (uint32_t i = 0; i < num_input_; ++i) out.input_vertex[i] = duplicate_of_[i];
   if (stitched_done_) {
-    out.tets = stitched_;
+    // Moved into out.tets at the end (StitchedFacetFaces reads stitched_).
   } else {
     const bool labelled = !tet_labels_.empty();
-    for (TetId t : dt.FiniteTets()) {
+    const std::vector<TetId> finite = dt.FiniteTets();
+    out.tets.reserve(finite.size());
+    if (labelled) out.tet_outside.reserve(finite.size());
+    for (TetId t : finite) {
       std::array<uint32_t, 4> tet;
       for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
       out.tets.push_back(tet);
@@ -3372,6 +3378,7 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     const CellSize cs = omega_.Size(VertexId(w));
     if (cs.inradius > 0) st.max_aspect = std::max(st.max_aspect, cs.kept_outradius / cs.inradius);
   }
+  if (stitched_done_) out.tets = std::move(stitched_);
   out.stats = st;
   return out;
 }
