@@ -194,14 +194,17 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // of the labelling). Two records: the tets are neighbours; more: not a
   // tetrahedralization (reported for the smallest (a, b, c), with its three
   // smallest slots).
-  const TetFaces tet_faces(in.tets, nv);
-  std::vector<uint32_t> nbr(4 * nt, kNoTet);  // slot -> opposite slot
-  {
+  const bool given = in.neighbor_slots.size() == 4 * nt && in.find_face != nullptr;
+  const TetFaces tet_faces(given ? std::span<const std::array<uint32_t, 4>>() : in.tets, given ? 0 : nv);
+  std::vector<uint32_t> own_nbr;
+  if (!given) own_nbr.assign(4 * nt, kNoTet);
+  const std::span<const uint32_t> nbr = given ? in.neighbor_slots : std::span<const uint32_t>(own_nbr);
+  if (!given) {
     TetFaces::Overused bad;
     if (!tet_faces.Match(
             [&](uint32_t s, uint32_t t) {
-              nbr[s] = t;
-              nbr[t] = s;
+              own_nbr[s] = t;
+              own_nbr[t] = s;
             },
             &bad)) {
       return absl::InvalidArgumentError(absl::StrCat("face (", bad.a, ", ", bad.b, ", ", bad.c, ") is in ",
@@ -243,24 +246,30 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
                           in.constrained_faces[keys[r].second].marker, "): the first is kept")});
         continue;
       }
-      // The face's first record (smallest slot) in the bucket of k[0].
-      const TetFace* it = nullptr;
-      for (const TetFace& f : tet_faces.Bucket(k[0])) {
-        if (f.b == k[1] && f.c == k[2]) {
-          it = &f;
-          break;
+      // The face's first record (smallest slot): in the bucket of k[0], or
+      // the smaller of the given slot and its neighbour.
+      uint32_t first_slot = kNoTet;
+      if (given) {
+        const uint32_t s = in.find_face(k[0], k[1], k[2]);
+        if (s != kNoTet) first_slot = nbr[s] != kNoTet ? std::min(s, nbr[s]) : s;
+      } else {
+        for (const TetFace& f : tet_faces.Bucket(k[0])) {
+          if (f.b == k[1] && f.c == k[2]) {
+            first_slot = f.slot;
+            break;
+          }
         }
       }
-      if (it == nullptr) {
+      if (first_slot == kNoTet) {
         return absl::InvalidArgumentError(absl::StrCat(
             "constrained face ", idx, " (", k[0], ", ", k[1], ", ", k[2], ") of facet ",
             in.constrained_faces[idx].facet, " is not a face of the tetrahedralization"));
       }
-      cface_slots[idx][0] = it->slot;
-      slot_cface[it->slot] = idx;
-      if (nbr[it->slot] != kNoTet) {
-        cface_slots[idx][1] = nbr[it->slot];
-        slot_cface[nbr[it->slot]] = idx;
+      cface_slots[idx][0] = first_slot;
+      slot_cface[first_slot] = idx;
+      if (nbr[first_slot] != kNoTet) {
+        cface_slots[idx][1] = nbr[first_slot];
+        slot_cface[nbr[first_slot]] = idx;
       }
     }
   }

@@ -2873,6 +2873,39 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   in.region_seeds = seeds;
   in.hole_seeds = holes;
   in.keep_bounding_box = options_.keep_bounding_box || facets_.empty();
+  // M_Ω's own tets: the adjacency comes from Delaunay3 instead of the
+  // labelling's face table (§8 item 43; the same labelling).
+  std::vector<uint32_t> compact, neighbor_slots;
+  std::vector<TetId> star;
+  if (!tet_ids.empty() && options_.label_with_adjacency) {
+    compact.assign(dt.TetCapacity(), kNoTet);
+    for (uint32_t i = 0; i < tet_ids.size(); ++i) compact[tet_ids[i].value()] = i;
+    neighbor_slots.assign(4 * tet_ids.size(), kNoTet);
+    for (uint32_t i = 0; i < tet_ids.size(); ++i) {
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = dt.Neighbor(tet_ids[i], f);
+        if (!dt.IsGhost(n)) neighbor_slots[4 * i + f] = 4 * compact[n.value()] + dt.NeighborFace(tet_ids[i], f);
+      }
+    }
+    in.neighbor_slots = neighbor_slots;
+    in.find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
+      dt.Star(VertexId(a), &star);
+      for (TetId t : star) {
+        if (dt.IsGhost(t)) continue;
+        int other = -1, found = 0;
+        for (int k = 0; k < 4; ++k) {
+          const uint32_t w = dt.TetVertex(t, k).value();
+          if (w == a || w == b || w == c) {
+            ++found;
+          } else {
+            other = k;
+          }
+        }
+        if (found == 3 && other >= 0) return 4 * compact[t.value()] + static_cast<uint32_t>(other);
+      }
+      return kNoTet;
+    };
+  }
   absl::StatusOr<Labelling> lab = LabelRegions(in);
   if (!lab.ok()) return lab.status();
   // Volumes scale by 2^−3e into normalised coordinates (exact).

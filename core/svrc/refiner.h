@@ -81,6 +81,10 @@ struct RefineOptions {
   // v's links, never reading other cells (the same choices: §8 item 41);
   // false: the cells above (tests).
   bool destroy_index = true;
+  // The size rounds label M_Ω with Delaunay3's adjacency instead of building
+  // the labelling's face table (§8 item 43; the same labelling); false: the
+  // table (tests).
+  bool label_with_adjacency = true;
   // UpdateLocation drops a shrunk cell's link to a lower ball that lies
   // wholly beyond the bisector of the cell's vertex and the new point, and
   // links the new cell's balls in ball-id order (docs/svrc-design.md §8 item

@@ -474,6 +474,24 @@ TEST(CollarRefine, IndexedDestroyMakesTheSameRefinement) {
   }
 }
 
+// The size rounds label M_Ω with Delaunay3's adjacency (neighbour slots and
+// a star walk per constrained face) instead of the labelling's face table
+// (RefineOptions::label_with_adjacency, §8 item 43): the same labelling, so
+// the same size targets and the same refinement bit for bit, on inputs with
+// max_volume (size rounds) and several regions. A neighbour slot off by a
+// face, or a constrained face found in the wrong tet, changes the regions
+// the flood reaches and with them the targets.
+TEST(CollarRefine, LabellingWithTheMeshAdjacencyMakesTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
+        SameRefinementCase{"b_internal/box_in_box.poly", false, 1e-3},
+        SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 1e-2}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->label_with_adjacency = on; });
+    EXPECT_GT(runs[0].stats.size_rounds, 0u) << c.rel;
+    EXPECT_EQ(runs[0].stats.size_rounds, runs[1].stats.size_rounds) << c.rel;
+  }
+}
+
 // The corpus file `file`, or families::NestedBoxes(3, 1e-2, 1/8) (three
 // regions with max volumes 1e-2, 1.25e-3, 1.5625e-4) for "nested".
 absl::StatusOr<plc::Plc> CaseInput(const std::string& file) {

@@ -4,6 +4,7 @@
 #include "core/svrc/labelling.h"
 
 #include <algorithm>
+#include <map>
 #include <random>
 
 #include "absl/strings/str_cat.h"
@@ -114,6 +115,69 @@ TEST(LabellingTest, NestedBoxesTwoRegionsAndAHole) {
     for (size_t t = 0; t < l->components[c].first_tet; ++t) EXPECT_LT(l->tet_component[t], c);
   }
   EXPECT_TRUE(l->components[0].touches_box);  // tet 0 is at the grid corner
+}
+
+// The caller's adjacency (LabelInput::neighbor_slots and find_face, as the
+// refiner's size rounds pass them from Delaunay3) gives the labelling the
+// face table gives, field for field — the faces' first tet included, though
+// find_face here answers with the larger of a face's two slots.
+TEST(LabellingTest, GivenAdjacencyGivesTheSameLabelling) {
+  Nested nb;
+  const std::vector<plc::RegionSeed> seeds = {{{1.5, 1.5, 1.5}, 10, 0}, {{2.5, 2.6, 2.7}, 20, 0.5}};
+  const std::vector<Vec3> holes = {{4.1, 4.2, 4.3}};
+  std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> slots_of;
+  for (uint32_t t = 0; t < nb.grid.tets.size(); ++t) {
+    for (uint32_t f = 0; f < 4; ++f) {
+      std::array<uint32_t, 3> k;
+      for (uint32_t j = 0, m = 0; j < 4; ++j) {
+        if (j != f) k[m++] = nb.grid.tets[t][j];
+      }
+      std::sort(k.begin(), k.end());
+      slots_of[k].push_back(4 * t + f);
+    }
+  }
+  std::vector<uint32_t> nbr(4 * nb.grid.tets.size(), kNoTet);
+  for (const auto& [k, sl] : slots_of) {
+    ASSERT_LE(sl.size(), 2u);
+    if (sl.size() == 2) {
+      nbr[sl[0]] = sl[1];
+      nbr[sl[1]] = sl[0];
+    }
+  }
+  LabelInput in = nb.Input(seeds, holes);
+  in.neighbor_slots = nbr;
+  in.find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
+    std::array<uint32_t, 3> k{a, b, c};
+    std::sort(k.begin(), k.end());
+    auto it = slots_of.find(k);
+    return it == slots_of.end() ? kNoTet : it->second.back();
+  };
+  auto given = LabelRegions(in);
+  auto table = LabelRegions(nb.Input(seeds, holes));
+  ASSERT_TRUE(given.ok()) << given.status();
+  ASSERT_TRUE(table.ok()) << table.status();
+  EXPECT_EQ(given->tet_component, table->tet_component);
+  ASSERT_EQ(given->components.size(), table->components.size());
+  for (size_t c = 0; c < table->components.size(); ++c) {
+    EXPECT_EQ(given->components[c].first_tet, table->components[c].first_tet);
+    EXPECT_EQ(given->components[c].num_tets, table->components[c].num_tets);
+    EXPECT_EQ(given->components[c].kept, table->components[c].kept);
+    EXPECT_EQ(given->components[c].touches_box, table->components[c].touches_box);
+    EXPECT_EQ(given->components[c].seed, table->components[c].seed);
+  }
+  EXPECT_EQ(given->seed_tet, table->seed_tet);
+  EXPECT_EQ(given->hole_tet, table->hole_tet);
+  EXPECT_EQ(given->num_kept_tets, table->num_kept_tets);
+  ASSERT_EQ(given->faces.size(), table->faces.size());
+  for (size_t i = 0; i < table->faces.size(); ++i) {
+    EXPECT_EQ(given->faces[i].tets, table->faces[i].tets) << i;
+    EXPECT_EQ(given->faces[i].constrained_face, table->faces[i].constrained_face) << i;
+  }
+  // A constrained face that is no face of the tets is still an error.
+  std::vector<ConstrainedFace> bad = nb.faces;
+  bad.push_back({{0, 1, nb.grid.Id(8, 8, 8)}, 9, 0});
+  in.constrained_faces = bad;
+  EXPECT_FALSE(LabelRegions(in).ok());
 }
 
 TEST(LabellingTest, KeepBoundingBoxKeepsEverything) {
