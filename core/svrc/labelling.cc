@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <utility>
 
 #include "absl/status/status.h"
@@ -195,13 +196,16 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // tetrahedralization (reported for the smallest (a, b, c), with its three
   // smallest slots).
   const bool given = in.neighbor_slots.size() == 4 * nt && in.find_face != nullptr;
-  const TetFaces tet_faces(given ? std::span<const std::array<uint32_t, 4>>() : in.tets, given ? 0 : nv);
+  std::optional<TetFaces> tet_faces;
   std::vector<uint32_t> own_nbr;
-  if (!given) own_nbr.assign(4 * nt, kNoTet);
+  if (!given) {
+    tet_faces.emplace(in.tets, nv);
+    own_nbr.assign(4 * nt, kNoTet);
+  }
   const std::span<const uint32_t> nbr = given ? in.neighbor_slots : std::span<const uint32_t>(own_nbr);
   if (!given) {
     TetFaces::Overused bad;
-    if (!tet_faces.Match(
+    if (!tet_faces->Match(
             [&](uint32_t s, uint32_t t) {
               own_nbr[s] = t;
               own_nbr[t] = s;
@@ -253,7 +257,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
         const uint32_t s = in.find_face(k[0], k[1], k[2]);
         if (s != kNoTet) first_slot = nbr[s] != kNoTet ? std::min(s, nbr[s]) : s;
       } else {
-        for (const TetFace& f : tet_faces.Bucket(k[0])) {
+        for (const TetFace& f : tet_faces->Bucket(k[0])) {
           if (f.b == k[1] && f.c == k[2]) {
             first_slot = f.slot;
             break;

@@ -237,6 +237,22 @@ class Refiner {
     });
   }
 
+  // The same with the warp targets from the pending-point index
+  // (near_pending_, the query Destroy made; §8 item 41) instead of the
+  // unresolved cells. The query's entries whose point entered M_Ω or became
+  // suppressed since they were indexed fail line 4's tests as they would in
+  // a cell; they leave the index here.
+  void GatherIndexedDestroyBalls(VertexId v, std::vector<BallId>* out) {
+    CollectBalls(out, [&](const auto& add) {
+      blg_.ForEachBall(kOmegaMesh, v.value(), add);
+      for (uint32_t id : near_pending_) add(BallId(id));
+    });
+    for (uint32_t id : near_pending_) {
+      const PointId q = balls_.VertexPoint(BallId(id));
+      if (points_.InMesh(q, kOmegaMesh) || Suppressed(q)) ErasePending(BallId(id));
+    }
+  }
+
   // Destroy's choices (Figure 3.4 lines 6 and 13): the warp target with the
   // lowest CD, then nearest to c, then the lowest point id; the yield ball
   // with the lowest CD, then the largest, then the lowest id (determinism).
@@ -1409,21 +1425,11 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     if (options_.destroy_index) {
       // §8 item 41: v's balls and the pending points within θr of c, which
       // are exactly the warp targets the cells would give (a 0-ball linked
-      // unresolved into M_Ω and not yet in it is in the index; the index's
-      // other entries, resolved or suppressed since, fail line 4's tests
-      // below as they would in a cell, and are erased here).
+      // unresolved into M_Ω and not yet in it is in the index).
       bfs_.assign(1, v);
       ++stats_.destroys_local;
       near_pending_.clear();
       stats_.destroy_index_visited += pending_.Near(c, options_.theta * r, &near_pending_);
-      CollectBalls(&gathered_, [&](const auto& add) {
-        blg_.ForEachBall(kOmegaMesh, v.value(), add);
-        for (uint32_t id : near_pending_) add(BallId(id));
-      });
-      for (uint32_t id : near_pending_) {
-        const PointId q = balls_.VertexPoint(BallId(id));
-        if (points_.InMesh(q, kOmegaMesh) || Suppressed(q)) ErasePending(BallId(id));
-      }
     } else if (unresolved_cells.size() <= options_.local_destroy_cells) {
       bfs_.assign(1, v);
       for (uint32_t u : unresolved_cells) {
@@ -1441,7 +1447,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, V
     BallId warp, yield;
     double warp_d2 = 0;
     if (options_.destroy_index) {
-      // gathered_ is filled above.
+      GatherIndexedDestroyBalls(v, &gathered_);
     } else if (options_.destroy_gather_all) {
       GatherBalls(kOmegaMesh, bfs_, &gathered_);
     } else {
