@@ -21,7 +21,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <initializer_list>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -45,10 +44,6 @@ class PodVector {
   PodVector() = default;
   explicit PodVector(size_t n) { resize(n); }
   PodVector(size_t n, const T& v) { resize(n, v); }
-  PodVector(std::initializer_list<T> init) {
-    reserve(init.size());
-    for (const T& v : init) push_back(v);
-  }
   PodVector(const PodVector& o) {
     reserve(o.size_);
     if (o.size_ > 0) std::memcpy(static_cast<void*>(data_), o.data_, o.size_ * sizeof(T));
@@ -117,11 +112,6 @@ class PodVector {
       return;
     }
     new (data_ + size_++) T(v);
-  }
-  template <typename... Args>
-  T& emplace_back(Args&&... args) {
-    push_back(T{std::forward<Args>(args)...});
-    return back();
   }
   void pop_back() { --size_; }
   void clear() { size_ = 0; }
