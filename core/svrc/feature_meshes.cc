@@ -2,6 +2,7 @@
 #include "core/svrc/feature_meshes.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "core/geometry/predicates.h"
@@ -51,25 +52,59 @@ bool OmegaMesh::InsideCube(const Vec3& p) const {
   return true;
 }
 
-const OmegaMesh::CcEntry& OmegaMesh::CachedCircumcenter(TetId t) const {
+namespace {
+// The table size for `n` keys: a power of two >= n, at most `limit` (0: no
+// limit).
+size_t CacheSize(size_t n, uint32_t limit) {
+  const size_t want = std::bit_ceil(std::max<size_t>(n, 64));
+  return limit == 0 ? want : std::min<size_t>(want, limit);
+}
+}  // namespace
+
+OmegaMesh::CcEntry OmegaMesh::ComputeCircumcenter(TetId t) const {
+  ++stats_.circumcentres;
+  CcEntry e;
+  e.cc = dt_.Circumcenter(t);
+  e.inside = InsideCube(e.cc);
+  const Vec3& a = dt_.Point(dt_.TetVertex(t, 0));
+  const Vec3 ab = dt_.Point(dt_.TetVertex(t, 1)) - a, ac = dt_.Point(dt_.TetVertex(t, 2)) - a,
+             ad = dt_.Point(dt_.TetVertex(t, 3)) - a;
+  const double vol6 = std::fabs(geom::Dot(ab, geom::Cross(ac, ad)));
+  const double l2 = std::max({geom::Norm2(ab), geom::Norm2(ac), geom::Norm2(ad), geom::Dist2(ab, ac),
+                              geom::Dist2(ab, ad), geom::Dist2(ac, ad)});
+  double scale = 0;
+  for (int k = 0; k < 3; ++k) scale = std::max({scale, std::fabs(a[k]), std::fabs(e.cc[k])});
+  e.flat = vol6 <= 1e-9 * l2 * std::sqrt(l2) + 3e-14 * l2 * std::min(scale, 4.0 * half_side_);
+  return e;
+}
+
+OmegaMesh::CcEntry OmegaMesh::CachedCircumcenter(TetId t) const {
   const uint32_t i = t.value();
-  if (cc_.size() <= i) util::GrowExactly(cc_, dt_.TetCapacity() + 64);
-  const uint32_t g = dt_.Generation(t) + 1;
-  CcEntry& e = cc_[i];
-  if (e.gen != g) {
-    e.cc = dt_.Circumcenter(t);
-    e.gen = g;
-    e.inside = InsideCube(e.cc);
-    const Vec3& a = dt_.Point(dt_.TetVertex(t, 0));
-    const Vec3 ab = dt_.Point(dt_.TetVertex(t, 1)) - a, ac = dt_.Point(dt_.TetVertex(t, 2)) - a,
-               ad = dt_.Point(dt_.TetVertex(t, 3)) - a;
-    const double vol6 = std::fabs(geom::Dot(ab, geom::Cross(ac, ad)));
-    const double l2 = std::max({geom::Norm2(ab), geom::Norm2(ac), geom::Norm2(ad), geom::Dist2(ab, ac),
-                                geom::Dist2(ab, ad), geom::Dist2(ac, ad)});
-    double scale = 0;
-    for (int k = 0; k < 3; ++k) scale = std::max({scale, std::fabs(a[k]), std::fabs(e.cc[k])});
-    e.flat = vol6 <= 1e-9 * l2 * std::sqrt(l2) + 3e-14 * l2 * std::min(scale, 4.0 * half_side_) ? 1 : 0;
+  if (i > CcRecord::kSlotMask) [[unlikely]] return ComputeCircumcenter(t);
+  if (cc_.size() <= i && (cc_limit_ == 0 || cc_.size() < cc_limit_)) {
+    // Grown: the records move to their new places (a record's place is its
+    // slot's low bits; the new places of the old records are distinct, and
+    // each is its old place or one beyond the old table).
+    const size_t old_size = cc_.size();
+    const size_t n = CacheSize(size_t{dt_.TetCapacity()} + 64, cc_limit_);
+    cc_.resize(n, CcRecord{});
+    const size_t mask = n - 1;
+    for (size_t k = 0; k < old_size; ++k) {
+      const uint32_t s = cc_[k].tag & CcRecord::kSlotMask;
+      if (s == CcRecord::kSlotMask || (s & mask) == k) continue;
+      cc_[s & mask] = cc_[k];
+      cc_[k] = CcRecord{};
+    }
   }
+  const uint32_t g = dt_.Generation(t) + 1;
+  CcRecord& r = cc_[i & (cc_.size() - 1)];
+  if ((r.tag & CcRecord::kSlotMask) == i && r.gen == g) {
+    return {r.cc, (r.tag & CcRecord::kInside) != 0, (r.tag & CcRecord::kFlat) != 0};
+  }
+  const CcEntry e = ComputeCircumcenter(t);
+  r.cc = e.cc;
+  r.gen = g;
+  r.tag = i | (e.inside ? CcRecord::kInside : 0) | (e.flat ? CcRecord::kFlat : 0);
   return e;
 }
 
@@ -126,25 +161,45 @@ void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* sc
   }
 }
 
+OmegaMesh::SizeMemo* OmegaMesh::MemoSlot(VertexId v, bool grow) const {
+  const uint32_t i = v.value();
+  if (size_memo_.size() <= i && (memo_limit_ == 0 || size_memo_.size() < memo_limit_)) {
+    if (!grow) return nullptr;
+    const size_t old_size = size_memo_.size();
+    const size_t n = CacheSize(size_t{dt_.NumVertices()} + dt_.NumVertices() / 2 + 16, memo_limit_);
+    size_memo_.resize(n, SizeMemo{});
+    const size_t mask = n - 1;
+    for (size_t k = 0; k < old_size; ++k) {
+      const uint32_t w = size_memo_[k].vertex;
+      if (w == 0xFFFFFFFFu || (w & mask) == k) continue;
+      size_memo_[w & mask] = size_memo_[k];
+      size_memo_[k] = SizeMemo{};
+    }
+  }
+  return &size_memo_[i & (size_memo_.size() - 1)];
+}
+
 CellSize OmegaMesh::Size(VertexId v) const {
   ++stats_.size_queries;
   const uint32_t key = dt_.StarVersion(v) + 1;
-  if (v.value() < size_memo_.size() && size_memo_[v.value()].key == key) {
-    const CellSize& m = size_memo_[v.value()].size;
+  const SizeMemo* old = MemoSlot(v, false);
+  if (old != nullptr && old->vertex == v.value() && old->key == key) {
+    const CellSize& m = old->size;
     if (m.clipped) ++stats_.clipped_queries;
     return m;
   }
   Uniqueness unique;
+  ++stats_.computed_sizes;
   const CellSize out = ComputeSize(v, &unique);
-  if (size_memo_.size() <= v.value()) util::GrowExactly(size_memo_, dt_.NumVertices() + dt_.NumVertices() / 2 + 16);
-  size_memo_[v.value()] = {key, out, out.hint.valid() ? dt_.Generation(out.hint) : 0,
-                           out.kept_hint.valid() ? dt_.Generation(out.kept_hint) : 0, unique};
+  *MemoSlot(v, true) = {v.value(), key, out, out.hint.valid() ? dt_.Generation(out.hint) : 0,
+                        out.kept_hint.valid() ? dt_.Generation(out.kept_hint) : 0, unique};
   return out;
 }
 
 bool OmegaMesh::ShrunkSize(VertexId v, const Vec3& p, const NewTets& added, CellSize* out) const {
-  if (v.value() >= size_memo_.size()) return false;
-  SizeMemo& m = size_memo_[v.value()];
+  SizeMemo* slot = MemoSlot(v, false);
+  if (slot == nullptr || slot->vertex != v.value()) return false;
+  SizeMemo& m = *slot;
   const uint32_t key = dt_.StarVersion(v) + 1;
   if (m.key == 0 || m.key + added.count != key || m.size.clipped || m.size.saw_flat) return false;
   auto survived = [&](TetId t, uint32_t gen) { return t.valid() && dt_.IsAlive(t) && dt_.Generation(t) == gen; };
@@ -204,7 +259,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
       needs_clip = true;
       break;
     }
-    const CcEntry& e = CachedCircumcenter(t);
+    const CcEntry e = CachedCircumcenter(t);
     if (e.flat) {
       out.saw_flat = true;
       continue;
@@ -253,7 +308,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
       kept_plain = false;
       continue;
     }
-    const CcEntry& e = CachedCircumcenter(t);
+    const CcEntry e = CachedCircumcenter(t);
     if (e.flat) continue;
     if (!e.inside) {
       kept_plain = false;
@@ -282,8 +337,8 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
     for (int guard = 0; guard < 1024; ++guard) {
       if (dt_.IsGhost(t)) {
         poly_.push_back(FarPoint(t));
-      } else if (!CachedCircumcenter(t).flat) {
-        poly_.push_back(CachedCircumcenter(t).cc);
+      } else if (const CcEntry e = CachedCircumcenter(t); !e.flat) {
+        poly_.push_back(e.cc);
       }
       // The two faces of t containing v and u are opposite its other two vertices.
       TetId next;

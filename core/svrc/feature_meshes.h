@@ -91,6 +91,16 @@ class OmegaMesh {
   // counts as kept). Drops every memo of Size().
   void SetLabels(const util::PodVector<TetLabel>* labels) {
     labels_ = labels;
+    for (SizeMemo& m : size_memo_) m.key = 0;
+  }
+  // The circumcentre cache and Size()'s memos hold at most 2^cc_log2 and
+  // 2^memo_log2 entries, direct-mapped by tet slot and vertex (a miss
+  // recomputes; answers do not depend on them). 0: one entry per slot /
+  // vertex, never evicted. docs/svrc-design.md §8 item 44.
+  void SetCacheLimits(uint32_t cc_log2, uint32_t memo_log2) {
+    cc_limit_ = cc_log2 == 0 ? 0 : uint32_t{1} << cc_log2;
+    memo_limit_ = memo_log2 == 0 ? 0 : uint32_t{1} << memo_log2;
+    cc_.clear();
     size_memo_.clear();
   }
   // t (a ghost, or a finite tet with a valid label) lies outside the output.
@@ -135,7 +145,7 @@ class OmegaMesh {
   // (R_v is the largest |cc − v| over v's star); false when Size() would not
   // read it plainly: t flat, or its circumcentre outside Ω (clipped cells).
   bool PlainCorner(TetId t, geom::Vec3* cc) const {
-    const CcEntry& e = CachedCircumcenter(t);
+    const CcEntry e = CachedCircumcenter(t);
     if (e.flat || !e.inside) return false;
     *cc = e.cc;
     return true;
@@ -150,6 +160,8 @@ class OmegaMesh {
     uint64_t size_queries = 0;
     uint64_t clipped_queries = 0;
     uint64_t shrunk_sizes = 0;  // ShrunkSize() answers
+    uint64_t computed_sizes = 0;  // Size() answers not from the memo
+    uint64_t circumcentres = 0;   // circumcentres computed (cc_ misses)
   };
   const Stats& stats() const { return stats_; }
 
@@ -168,20 +180,32 @@ class OmegaMesh {
   void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
   // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
   // generation): each tet is in four stars and Size() is called for every
-  // cavity vertex (Figure 3.5). One 32-byte record per slot: one cache line.
+  // cavity vertex (Figure 3.5).
   struct CcEntry {
     geom::Vec3 cc;
-    uint32_t gen = 0;     // generation + 1 of the cached value; 0: none
-    uint16_t inside = 0;  // InsideCube(cc)
+    bool inside = false;  // InsideCube(cc)
     // Its four vertices are coplanar up to rounding (|volume| at noise level):
     // four cocircular points of one facet, rounded off the plane. Its
     // computed circumcentre is noise along the circle's axis, not a Voronoi
     // vertex of the exact configuration, so R_v ignores it; the cell's
     // corners on that axis are the circumcentres of the tets on either side,
     // which share v (docs/svrc-design.md §10).
-    uint16_t flat = 0;
+    bool flat = false;
   };
-  const CcEntry& CachedCircumcenter(TetId t) const;
+  // The cache: a table of 2^k 32-byte records indexed by the slot's low bits
+  // (SetCacheLimits), grown with the mesh up to its limit (the tets of the
+  // insertions' cavities are what it serves). Slots from 2^30 on are not
+  // cached (a billion tets would not fit in memory anyway).
+  struct CcRecord {
+    static constexpr uint32_t kSlotMask = (uint32_t{1} << 30) - 1;
+    static constexpr uint32_t kInside = uint32_t{1} << 30, kFlat = uint32_t{1} << 31;
+    geom::Vec3 cc;
+    uint32_t tag = kSlotMask;  // the tet slot cached here | kInside | kFlat; kSlotMask: none
+    uint32_t gen = 0;          // generation + 1 of the cached value
+  };
+  static_assert(sizeof(CcRecord) == 32);
+  // By value: another tet's lookup may take the same record.
+  CcEntry CachedCircumcenter(TetId t) const;
   // A far point on the Voronoi ray of ghost tet g (outside Ω).
   geom::Vec3 FarPoint(TetId ghost) const;
 
@@ -193,11 +217,14 @@ class OmegaMesh {
   std::vector<EventHandle> skinny_event_;
   std::vector<EventHandle> unresolved_event_;
   mutable Stats stats_;
-  mutable util::PodVector<CcEntry> cc_;
+  mutable util::PodVector<CcRecord> cc_;
+  CcEntry ComputeCircumcenter(TetId t) const;
   // Size() per vertex, valid while the vertex's star is unchanged
   // (Delaunay3::StarVersion): the event loop asks again for cells that did
   // not change (IsLive, Output, invariant checks).
+  // Direct-mapped by the vertex's low bits, like cc_ (SetCacheLimits).
   struct SizeMemo {
+    uint32_t vertex = 0xFFFFFFFFu;  // the vertex memoised here
     uint32_t key = 0;  // StarVersion + 1 when computed; 0: none
     CellSize size;
     uint32_t hint_gen = 0;       // Generation(size.hint) when computed
@@ -205,6 +232,11 @@ class OmegaMesh {
     Uniqueness unique;
   };
   mutable util::PodVector<SizeMemo> size_memo_;
+  // The memo of v (its record, possibly another vertex's); nullptr before
+  // the table covers v's index, unless `grow`.
+  SizeMemo* MemoSlot(VertexId v, bool grow) const;
+  uint32_t cc_limit_ = 0;    // 0: unbounded
+  uint32_t memo_limit_ = 0;  // 0: unbounded
   const util::PodVector<TetLabel>* labels_ = nullptr;
   // Scratch.
   mutable std::vector<geom::Vec3> poly_, poly2_;

@@ -4,21 +4,38 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <new>
 #include "core/util/grow.h"
 
 namespace svrc::refine {
 
 namespace {
-// First block size: most cells and objects hold a handful of links (bounded
-// ply, Lemma 6), so small blocks keep an array within one or two cache lines.
-constexpr uint32_t kMinCap = 4;
+// Block capacities come in classes 2, 3, 4, 6, 8, 12, 16, 24, ...: class
+// 2j holds 2^(j+1) entries, class 2j+1 holds 3·2^j (§8 item 45). Most cells
+// and objects hold a handful of links (bounded ply, Lemma 6); steps of 1.5
+// leave a third as much room unused on average as steps of 2, and the
+// smallest block (2) fits the many arrays of one or two links.
+constexpr uint32_t ClassCap(uint32_t k) { return (k & 1) == 0 ? uint32_t{2} << (k / 2) : uint32_t{3} << (k / 2); }
+// The class of a block of `cap` entries (a ClassCap value).
+constexpr uint32_t CapClass(uint32_t cap) {
+  return std::has_single_bit(cap) ? 2 * (std::countr_zero(cap) - 1) : 2 * std::countr_zero(cap / 3) + 1;
+}
+// The smallest class capacity >= size (size >= 1).
+constexpr uint32_t FitCap(uint32_t size) {
+  if (size <= 2) return 2;
+  const uint32_t p = std::bit_ceil(size);  // p/2 < size <= p
+  return size <= p / 4 * 3 ? p / 4 * 3 : p;
+}
+static_assert(ClassCap(0) == 2 && ClassCap(1) == 3 && ClassCap(2) == 4 && ClassCap(3) == 6 && ClassCap(5) == 12);
+static_assert(CapClass(2) == 0 && CapClass(3) == 1 && CapClass(24) == 7 && CapClass(32) == 8);
+static_assert(FitCap(1) == 2 && FitCap(3) == 3 && FitCap(5) == 6 && FitCap(7) == 8 && FitCap(9) == 12 && FitCap(13) == 16);
 }  // namespace
 
 template <typename Entry>
 void LocationGraph::Arena<Entry>::Append(Span& s, const Entry& e) {
   if (s.size == s.cap) {
-    const uint32_t cap = s.cap == 0 ? kMinCap : 2 * s.cap;
-    std::vector<uint32_t>& from = free_[std::countr_zero(cap)];
+    const uint32_t cap = s.cap == 0 ? ClassCap(0) : ClassCap(CapClass(s.cap) + 1);
+    std::vector<uint32_t>& from = free_[CapClass(cap)];
     uint32_t offset;
     if (!from.empty()) {
       offset = from.back();
@@ -29,7 +46,7 @@ void LocationGraph::Arena<Entry>::Append(Span& s, const Entry& e) {
       pool_.resize(pool_.size() + cap);
     }
     if (s.size > 0) std::memcpy(pool_.data() + offset, pool_.data() + s.offset, s.size * sizeof(Entry));
-    if (s.cap != 0) free_[std::countr_zero(s.cap)].push_back(s.offset);
+    if (s.cap != 0) free_[CapClass(s.cap)].push_back(s.offset);
     s.offset = offset;
     s.cap = cap;
   }
@@ -46,15 +63,15 @@ void LocationGraph::Arena<Entry>::Erase(Span& s, uint32_t i) {
 
 template <typename Entry>
 void LocationGraph::Arena<Entry>::Release(Span& s) {
-  if (s.cap != 0) free_[std::countr_zero(s.cap)].push_back(s.offset);
+  if (s.cap != 0) free_[CapClass(s.cap)].push_back(s.offset);
   s = Span{};
 }
 
 template <typename Entry>
 bool LocationGraph::Arena<Entry>::WouldGrow(const Span& s) const {
   if (s.size < s.cap) return false;
-  const uint32_t cap = s.cap == 0 ? kMinCap : 2 * s.cap;
-  return free_[std::countr_zero(cap)].empty() && pool_.size() + cap > pool_.capacity();
+  const uint32_t cap = s.cap == 0 ? ClassCap(0) : ClassCap(CapClass(s.cap) + 1);
+  return free_[CapClass(cap)].empty() && pool_.size() + cap > pool_.capacity();
 }
 
 template <typename Entry>
@@ -68,7 +85,7 @@ void LocationGraph::Arena<Entry>::Compact(const std::vector<Span*>& spans) {
       s->cap = 0;
       continue;
     }
-    const uint32_t cap = std::max(kMinCap, std::bit_ceil(s->size));
+    const uint32_t cap = FitCap(s->size);
     if (s->offset != next) std::memmove(pool_.data() + next, pool_.data() + s->offset, s->size * sizeof(Entry));
     s->offset = next;
     s->cap = cap;
@@ -80,7 +97,7 @@ void LocationGraph::Arena<Entry>::Compact(const std::vector<Span*>& spans) {
 
 namespace {
 // The packed size of arrays of these sizes (Arena::Compact's blocks).
-uint64_t PackedSize(uint32_t size) { return size == 0 ? 0 : std::max(kMinCap, std::bit_ceil(size)); }
+uint64_t PackedSize(uint32_t size) { return size == 0 ? 0 : FitCap(size); }
 }  // namespace
 
 template <typename Entry>
@@ -187,6 +204,11 @@ bool LocationGraph::IsLinked(MeshId mesh, uint32_t cell, LocationObject object) 
 AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject object,
                                      const LinkFacts& facts, BallStore* balls) {
   AddLinkResult result;
+  if (object.id > CellEntry::kIdMask) [[unlikely]] {
+    // Not representable in a cell entry; the refiner reports an allocation
+    // failure as RESOURCE_EXHAUSTED "out of memory".
+    throw std::bad_alloc();
+  }
   // One lookup per side (the spans are created here if new; an empty span
   // is no link). The duplicate test scans the shorter array, as IsLinked.
   CellSpanT& cs = CellSpan(mesh, cell);
@@ -198,7 +220,7 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
   }
   if (cell_arena_.WouldGrow(cs)) [[unlikely]] MaybeCompactCells();
   if (object_arena_.WouldGrow(os)) [[unlikely]] MaybeCompactObjects();
-  cell_arena_.Append(cs, CellEntry{object.id, object.kind, facts.unresolved});
+  cell_arena_.Append(cs, CellEntry::Make(object, facts.unresolved));
   object_arena_.Append(os, ObjectEntry{mesh.value(), cell});
   ++num_links_;
   ++stats_.links_added;
@@ -221,7 +243,7 @@ AddLinkResult LocationGraph::AddLink(MeshId mesh, uint32_t cell, LocationObject 
 }
 
 void LocationGraph::RemoveAt(MeshId mesh, CellSpanT& cs, uint32_t ci, Span& os, uint32_t oi) {
-  if (cell_arena_.Data(cs)[ci].unresolved && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
+  if (cell_arena_.Data(cs)[ci].unresolved() && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
   cell_arena_.Erase(cs, ci);
   object_arena_.Erase(os, oi);
   --num_links_;
@@ -272,7 +294,7 @@ void LocationGraph::RemoveCellLinksWhere(MeshId mesh, uint32_t cell, const std::
     const LocationObject object = e[i].object();
     Span& os = ObjectSpan(object);
     object_arena_.Erase(os, ObjectPos(os, mesh, cell));
-    if (e[i].unresolved && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
+    if (e[i].unresolved() && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
   }
   num_links_ -= cs.size - kept;
   stats_.links_removed += cs.size - kept;
@@ -295,7 +317,7 @@ void LocationGraph::RemoveObjectLinks(LocationObject object, MeshId mesh, std::v
     if (cells != nullptr) cells->push_back(oe.cell);
     CellSpanT& cs = cell_spans_[oe.mesh][oe.cell];
     const uint32_t ci = CellPos(cs, object);
-    if (cell_arena_.Data(cs)[ci].unresolved && --cs.unresolved == 0) LeaveUnresolved(MeshId(oe.mesh), cs);
+    if (cell_arena_.Data(cs)[ci].unresolved() && --cs.unresolved == 0) LeaveUnresolved(MeshId(oe.mesh), cs);
     cell_arena_.Erase(cs, ci);
     --num_links_;
     ++stats_.links_removed;
@@ -309,7 +331,7 @@ void LocationGraph::BallsOf(MeshId mesh, uint32_t cell, std::vector<BallId>* out
   if (cs == nullptr) return;
   const CellEntry* e = cell_arena_.Data(*cs);
   for (uint32_t i = 0; i < cs->size; ++i) {
-    if (e[i].kind == ObjectKind::kBall) out->push_back(BallId(e[i].object_id));
+    if (e[i].is_ball()) out->push_back(BallId(e[i].object_id()));
   }
 }
 
@@ -348,7 +370,7 @@ bool LocationGraph::Validate() const {
       for (uint32_t i = 0; i < cs.size; ++i) {
         const Span* os = FindObjectSpan(e[i].object());
         if (os == nullptr || ObjectPos(*os, MeshId(m), c) == kNil) return false;
-        if (e[i].unresolved) ++unresolved;
+        if (e[i].unresolved()) ++unresolved;
         ++count;
       }
       if (cs.unresolved != unresolved) return false;

@@ -5,10 +5,11 @@
 // links are added (AddLink) so the refiner can enqueue work events.
 //
 // Representation (guide §2 "BLG"; issue #5): contiguous arrays, not linked
-// lists. Per (mesh, cell) one array of {object, unresolved} entries, per
-// object one array of {mesh, cell} entries (8 bytes: the removal of a cell's
-// links scans its objects' arrays); each array is a block of a shared
-// arena (power-of-two capacities, recycled through per-size free lists). Adds
+// lists. Per (mesh, cell) one array of {object, unresolved} entries (4
+// bytes), per object one array of {mesh, cell} entries (8 bytes: the removal
+// of a cell's links scans its objects' arrays); each array is a block of a
+// shared arena (capacities in classes 2, 3, 4, 6, 8, 12, ..., recycled
+// through per-class free lists). Adds
 // append at the end and removals shift the tail down by one, so iteration
 // order is the order of AddLink calls (deterministic; the refiner's output
 // depends on it). A link is its (mesh, cell, object) triple: there is no
@@ -88,7 +89,7 @@ class LocationGraph {
     if (cs == nullptr) return;
     const CellEntry* e = cell_arena_.Data(*cs);
     for (uint32_t i = 0, n = cs->size; i < n; ++i) {
-      if (e[i].kind == ObjectKind::kBall) f(BallId(e[i].object_id));
+      if (e[i].is_ball()) f(BallId(e[i].object_id()));
     }
   }
   // The balls of the cell's unresolved links only (0-balls whose point is
@@ -99,7 +100,7 @@ class LocationGraph {
     if (cs == nullptr || cs->unresolved == 0) return;
     const CellEntry* e = cell_arena_.Data(*cs);
     for (uint32_t i = 0, n = cs->size; i < n; ++i) {
-      if (e[i].unresolved && e[i].kind == ObjectKind::kBall) f(BallId(e[i].object_id));
+      if (e[i].unresolved() && e[i].is_ball()) f(BallId(e[i].object_id()));
     }
   }
   // All objects linked to cell v of mesh F, in link order.
@@ -148,7 +149,7 @@ class LocationGraph {
   struct Span {
     uint32_t offset = 0;
     uint32_t size = 0;
-    uint32_t cap = 0;  // 0: no block yet; otherwise a power of two
+    uint32_t cap = 0;  // 0: no block yet; otherwise a class capacity (2, 3, 4, 6, 8, ...)
   };
   // A cell's span also counts its unresolved links (next to its size: one
   // access for both). An object's span is a plain Span (12 bytes per ball).
@@ -157,7 +158,7 @@ class LocationGraph {
     uint32_t upos = 0;  // unresolved > 0: position in unresolved_cells_
   };
   // Blocks of small arrays in one vector. A full block moves to a block of
-  // twice its capacity (taken from that size's free list, else appended); the
+  // the next class (taken from that class's free list, else appended); the
   // old block goes to its free list. Blocks of emptied arrays are kept (a cell
   // emptied by UpdateLocation is usually refilled at once) except a dead
   // object's (RemoveObjectLinks): ball ids are not reused. Blocks of arrays
@@ -179,25 +180,34 @@ class LocationGraph {
     bool WouldGrow(const Span& s) const;
     // Packs the blocks of `spans` (every span with a block, sorted by offset)
     // to the front of the pool, each array keeping its entries in order in a
-    // block of max(kMinCap, bit_ceil(size)) entries (an empty array loses its
+    // block of the smallest class that holds it (an empty array loses its
     // block); the free lists are emptied.
     void Compact(const std::vector<Span*>& spans);
     uint64_t PoolSize() const { return pool_.size(); }
 
    private:
     util::PodVector<Entry> pool_;
-    std::vector<uint32_t> free_[32];  // [log2 cap] offsets of free blocks
+    std::vector<uint32_t> free_[64];  // [class of cap] offsets of free blocks
   };
 
-  // The cell side: which object, and whether the link counts as unresolved.
+  // The cell side: which object, and whether the link counts as unresolved,
+  // in 4 bytes (the object's id in the low 30 bits, its kind in bit 30, the
+  // flag in bit 31; §8 item 45). Ids from 2^30 on are refused (AddLink):
+  // a billion balls are 64 GB of ball records alone.
   struct CellEntry {
-    uint32_t object_id = 0;
-    ObjectKind kind = ObjectKind::kBall;
-    bool unresolved = false;
-    LocationObject object() const { return {kind, object_id}; }
-    bool Is(LocationObject o) const { return object_id == o.id && kind == o.kind; }
+    static constexpr uint32_t kIdMask = (uint32_t{1} << 30) - 1;
+    uint32_t bits = 0;
+    static CellEntry Make(LocationObject o, bool unresolved) {
+      return {o.id | (o.kind == ObjectKind::kCollar ? uint32_t{1} << 30 : 0) | (unresolved ? uint32_t{1} << 31 : 0)};
+    }
+    uint32_t object_id() const { return bits & kIdMask; }
+    ObjectKind kind() const { return (bits >> 30 & 1) != 0 ? ObjectKind::kCollar : ObjectKind::kBall; }
+    bool unresolved() const { return (bits >> 31) != 0; }
+    bool is_ball() const { return (bits >> 30 & 1) == 0; }
+    LocationObject object() const { return {kind(), object_id()}; }
+    bool Is(LocationObject o) const { return (bits & ~(uint32_t{1} << 31)) == Make(o, false).bits; }
   };
-  static_assert(sizeof(CellEntry) == 8);
+  static_assert(sizeof(CellEntry) == 4);
   // The object side: which cell of which mesh.
   struct ObjectEntry {
     uint32_t mesh = 0;

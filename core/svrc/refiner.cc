@@ -100,7 +100,9 @@ double LongestEdgeCubed(const std::array<Vec3, 4>& x) {
 class Refiner {
  public:
   Refiner(const RefineOptions& options, Normalization norm, const Vec3& center, double half)
-      : options_(options), norm_(norm), omega_(center, half), pending_(center, half), collar_snap_(options.collar_snap) {}
+      : options_(options), norm_(norm), omega_(center, half), pending_(center, half), collar_snap_(options.collar_snap) {
+    omega_.SetCacheLimits(options.omega_cc_log2, options.omega_memo_log2);
+  }
 
   absl::Status Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments);
   // Shared by both entry points: the complex's points are `normalised` (global
@@ -3311,6 +3313,9 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.links_removed = blg_.stats().links_removed;
   st.clipped_cells = omega_.stats().clipped_queries;
   st.sizes_shrunk = omega_.stats().shrunk_sizes;
+  st.size_queries = omega_.stats().size_queries;
+  st.sizes_computed = omega_.stats().computed_sizes;
+  st.circumcentres = omega_.stats().circumcentres;
 }
 
 PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
@@ -3440,6 +3445,9 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.sizes_certified", static_cast<double>(sizes_certified));
   out->Set("svrc.sizes_uncertified", static_cast<double>(sizes_uncertified));
   out->Set("svrc.sizes_shrunk", static_cast<double>(sizes_shrunk));
+  out->Set("svrc.size_queries", static_cast<double>(size_queries));
+  out->Set("svrc.sizes_computed", static_cast<double>(sizes_computed));
+  out->Set("svrc.circumcentres", static_cast<double>(circumcentres));
   out->Set("svrc.size_targets_propagated", static_cast<double>(size_targets_propagated));
   out->Set("svrc.sizes_outside", static_cast<double>(sizes_outside));
   out->Set("svrc.sizes_clipped", static_cast<double>(clipped_cells));

@@ -85,6 +85,13 @@ struct RefineOptions {
   // the labelling's face table (§8 item 43; the same labelling); false: the
   // table (tests).
   bool label_with_adjacency = true;
+  // M_Ω's circumcentre cache and Size() memos hold at most 2^omega_cc_log2
+  // and 2^omega_memo_log2 records, direct-mapped (OmegaMesh::
+  // SetCacheLimits; §8 item 44): memory a run would otherwise spend per tet
+  // slot and per vertex. 0: one per slot / vertex. Outputs do not depend on
+  // them.
+  uint32_t omega_cc_log2 = 20;
+  uint32_t omega_memo_log2 = 18;
   // UpdateLocation drops a shrunk cell's link to a lower ball that lies
   // wholly beyond the bisector of the cell's vertex and the new point, and
   // links the new cell's balls in ball-id order (docs/svrc-design.md §8 item
@@ -259,6 +266,9 @@ struct RefineStats {
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)
+  uint64_t size_queries = 0;       // M_Ω Size() calls (and ShrunkSize answers)
+  uint64_t sizes_computed = 0;     // ... that walked the star (no memo)
+  uint64_t circumcentres = 0;      // M_Ω circumcentres computed (cache misses)
   uint64_t size_targets_propagated = 0;  // max_volume targets given between size rounds
   uint64_t sizes_outside = 0;            // cavity cells outside the output, not sized (size_kept_tets)
   uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)

@@ -492,6 +492,32 @@ TEST(CollarRefine, LabellingWithTheMeshAdjacencyMakesTheSameRefinement) {
   }
 }
 
+// M_Ω's circumcentre cache and Size() memos bounded and direct-mapped
+// (RefineOptions::omega_cc_log2 / omega_memo_log2, §8 item 44): tables of
+// 64 circumcentres and 16 memos, where nearly every lookup meets another
+// tet's or vertex's record, against one record per slot and vertex. The
+// same refinement bit for bit, on the collar path (knife_edge, segment_fan)
+// and with size rounds; a record answering for the wrong tet or vertex, or
+// a ShrunkSize on an evicted memo, changes it.
+TEST(CollarRefine, BoundedOmegaCachesMakeTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"c_creases/knife_edge.poly", true, 0}, SameRefinementCase{"d_small_angles/segment_fan.poly", true, 0},
+        SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4}}) {
+    if (kSanitized && c.collars) continue;
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
+      o->omega_cc_log2 = on ? 6 : 0;
+      o->omega_memo_log2 = on ? 4 : 0;
+    });
+    EXPECT_GT(runs[1].stats.circumcentres, 2 * runs[0].stats.circumcentres) << c.rel;
+    EXPECT_GT(runs[1].stats.sizes_computed, runs[0].stats.sizes_computed) << c.rel;
+    EXPECT_GT(runs[1].stats.sizes_shrunk, 0u) << c.rel;
+    std::printf("%s: %llu circumcentres and %llu star walks with 64 / 16 records, %llu and %llu with one per slot / "
+                "vertex\n",
+                c.rel, (unsigned long long)runs[1].stats.circumcentres, (unsigned long long)runs[1].stats.sizes_computed,
+                (unsigned long long)runs[0].stats.circumcentres, (unsigned long long)runs[0].stats.sizes_computed);
+  }
+}
+
 // The corpus file `file`, or families::NestedBoxes(3, 1e-2, 1/8) (three
 // regions with max volumes 1e-2, 1.25e-3, 1.5625e-4) for "nested".
 absl::StatusOr<plc::Plc> CaseInput(const std::string& file) {

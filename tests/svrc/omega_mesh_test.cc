@@ -21,6 +21,8 @@ struct Counts {
   size_t shrunk = 0;
   size_t cavity_cells = 0;
   size_t shrunk_outside = 0;  // ... of cells with tets outside (labelled)
+  uint64_t a_circumcentres = 0, b_circumcentres = 0;  // computed (cache misses)
+  uint64_t a_sizes_computed = 0;                      // a's Size() answers not from its memo
 };
 
 // Inserts `pts` into two copies of M_Ω. In `a`, every cavity cell is sized
@@ -30,8 +32,13 @@ struct Counts {
 // With `labelled`, every tet gets a label when it is made (kept: its
 // centroid has x > 0.45; both meshes make the same tets in the same slots),
 // and the kept_* fields are compared too.
-Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool labelled = false) {
+// `a` holds at most 2^cc_log2 circumcentres and 2^memo_log2 memos (0: one
+// per slot / vertex; OmegaMesh::SetCacheLimits), `b` one per slot / vertex.
+Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool labelled = false, uint32_t cc_log2 = 0,
+                    uint32_t memo_log2 = 0) {
   OmegaMesh a(Vec3{0.5, 0.5, 0.5}, 2.0), b(Vec3{0.5, 0.5, 0.5}, 2.0);
+  a.SetCacheLimits(cc_log2, memo_log2);
+  b.SetCacheLimits(0, 0);
   util::PodVector<TetLabel> labels;
   if (labelled) {
     a.SetLabels(&labels);
@@ -42,6 +49,11 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
   a.SeedCorners(corners);
   b.SeedCorners(corners);
   Counts out;
+  auto count_work = [&] {
+    out.a_circumcentres = a.stats().circumcentres;
+    out.b_circumcentres = b.stats().circumcentres;
+    out.a_sizes_computed = a.stats().computed_sizes;
+  };
   std::vector<uint32_t> pos(pts.size() + 16, UINT32_MAX);
   for (size_t n = 0; n < pts.size(); ++n) {
     const PointId id(static_cast<uint32_t>(8 + n));
@@ -107,6 +119,7 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
     a.Size(ra.vertex);
     b.Size(rb.vertex);
   }
+  count_work();
   return out;
 }
 
@@ -134,6 +147,23 @@ TEST(OmegaMeshTest, ShrunkSizeOfLabelledCells) {
 TEST(OmegaMeshTest, ShrunkSizeNoticesStaleMemos) {
   const Counts c = CompareSizes(RandomPoints(34, 2000), true);
   EXPECT_GT(c.shrunk, 0u);
+}
+
+// The circumcentre cache and the memos bounded and direct-mapped (§8 item
+// 44): a record holding another tet's circumcentre or another vertex's
+// memo must never answer, and an evicted memo must only cost a star walk.
+// Tiny tables (32 circumcentres, 16 memos) make every lookup collide; a
+// larger one (2^10 / 2^8) grows through its sizes while the mesh does and
+// then stops.
+TEST(OmegaMeshTest, BoundedCachesGiveTheSameSizes) {
+  for (const auto& [cc_log2, memo_log2] : {std::pair<uint32_t, uint32_t>{5, 4}, {10, 8}}) {
+    const Counts c = CompareSizes(RandomPoints(91, 3000), false, false, cc_log2, memo_log2);
+    EXPECT_GT(c.shrunk, 0u);
+    // The bound was in force: a computed more circumcentres than b.
+    EXPECT_GT(c.a_circumcentres, c.b_circumcentres + c.b_circumcentres / 10) << cc_log2;
+  }
+  const Counts labelled = CompareSizes(RandomPoints(92, 2000), true, true, 6, 3);
+  EXPECT_GT(labelled.a_circumcentres, labelled.b_circumcentres);
 }
 
 TEST(OmegaMeshTest, ShrunkSizeOnALatticeWithTiedCorners) {

@@ -206,6 +206,41 @@ TEST(LocationGraphTest, AddRemoveBothDirectionsAgree) {
   ASSERT_TRUE(g.Validate());
 }
 
+// A cell-side entry is 4 bytes: the object's id in 30 bits, its kind and
+// the unresolved flag in the other two (§8 item 45). A ball and a collar of
+// the same id in one cell stay two links, each with its own flag; an id
+// that does not fit is refused before anything is stored.
+TEST(LocationGraphTest, CellEntriesKeepKindAndFlagApart) {
+  LocationGraph g;
+  BallStore balls;
+  const MeshId m = kOmegaMesh;
+  LinkFacts unresolved;
+  unresolved.unresolved = true;
+  const uint32_t id = 37;
+  ASSERT_TRUE(g.AddLink(m, 3, LocationObject::Collar(id), {}, &balls).added);
+  ASSERT_TRUE(g.AddLink(m, 3, LocationObject::Ball(BallId(id)), unresolved, &balls).added);
+  EXPECT_FALSE(g.AddLink(m, 3, LocationObject::Ball(BallId(id)), {}, &balls).added);  // the flag is no part of the link
+  EXPECT_EQ(g.NumUnresolved(m, 3), 1u);
+  std::vector<LocationObject> objs;
+  g.ObjectsOf(m, 3, &objs);
+  EXPECT_EQ(objs, (std::vector<LocationObject>{LocationObject::Collar(id), LocationObject::Ball(BallId(id))}));
+  std::vector<BallId> unresolved_balls;
+  g.ForEachUnresolvedBall(m, 3, [&](BallId b) { unresolved_balls.push_back(b); });
+  EXPECT_EQ(unresolved_balls, std::vector<BallId>{BallId(id)});
+  // The ball's entry is the second: removing it must leave the collar's.
+  EXPECT_TRUE(g.RemoveLink(m, 3, LocationObject::Ball(BallId(id))));
+  EXPECT_EQ(g.NumUnresolved(m, 3), 0u);
+  objs.clear();
+  g.ObjectsOf(m, 3, &objs);
+  EXPECT_EQ(objs, std::vector<LocationObject>{LocationObject::Collar(id)});
+  EXPECT_TRUE(g.Validate());
+  EXPECT_TRUE(g.RemoveLink(m, 3, LocationObject::Collar(id)));
+  EXPECT_THROW(g.AddLink(m, 3, LocationObject::Ball(BallId(uint32_t{1} << 30)), {}, &balls), std::bad_alloc);
+  EXPECT_THROW(g.AddLink(m, 3, LocationObject::Collar(uint32_t{1} << 30), {}, &balls), std::bad_alloc);
+  EXPECT_EQ(g.NumLinks(), 0u);
+  EXPECT_TRUE(g.Validate());
+}
+
 TEST(LocationGraphTest, TrapsEncroachmentAndUnresolved) {
   LocationGraph g;
   BallStore balls;
