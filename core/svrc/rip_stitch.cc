@@ -455,6 +455,8 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     ++cp.books;
     books.push_back(bk);
   }
+  // Read by nothing below; at the output below it would sit beside the tets.
+  std::vector<EdgeRec>().swap(erec);
 
   // --- Vertices: used by outside tets (hull vertices count: ghosts are outside).
   std::vector<uint8_t> outside_vertex(nv, 0);
@@ -486,6 +488,7 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
   // --- 5. Exact verification of the assembled stitch (only if nothing failed).
   std::vector<std::array<uint32_t, 4>> stitched;
   if (fails.empty()) {
+    stitched.reserve(faces.size() + books.size());
     for (const BoundaryFace& bf : faces) {
       std::array<uint32_t, 4> star = bf.tet;
       star[bf.f] = in.balls[bf.ball].centre.value();
@@ -574,7 +577,12 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     return absl::FailedPreconditionError(msg);
   }
 
-  // --- Output and measurements.
+  std::vector<std::array<uint32_t, 4>>().swap(stitched);  // verified; the output rebuilds them
+  std::vector<uint8_t>().swap(outside_vertex);
+  // --- Output and measurements. Reserved exactly: a vector doubling here
+  // held two copies of M_Ω's outside tets at the run's heap peak (bunny.off:
+  // 10 M tets in M_Ω at the stitch).
+  res.tets.reserve(size_t{res.outside_tets} + faces.size() + books.size());
   for (uint32_t ti = 0; ti < cap; ++ti) {
     const TetId t(ti);
     if (!dt.IsAlive(t) || dt.IsGhost(t) || inside[ti]) continue;
