@@ -666,8 +666,16 @@ void Delaunay3::set_cache_neighbors(bool on) {
 // is rebuilt with only the live lists (in vertex order) and room for half as
 // many again: copying is amortised over at least live/2 appends, and the pool
 // never holds more than ~1.5× the live lists (~3× while being rebuilt).
+// Beyond adj_limit_ live entries every list is dropped instead: the pool then
+// stays within ~1.5× the limit (a run with 10^7 vertices held ~10^8 entries).
 void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
   if (adj_.size() <= v) util::GrowExactly(adj_, points_.size() + points_.size() / 2 + 16);
+  if (adj_pool_.size() + m > adj_pool_.capacity() && adj_limit_ != 0 && adj_live_ + m > adj_limit_) {
+    for (AdjEntry& e : adj_) e.size = kNoAdj;
+    adj_pool_.clear();
+    adj_live_ = 0;
+    ++adj_flushes_;
+  }
   if (adj_pool_.size() + m > adj_pool_.capacity()) {
     std::vector<VertexId> pool;
     pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);

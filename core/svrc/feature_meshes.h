@@ -97,7 +97,10 @@ class OmegaMesh {
   // 2^memo_log2 entries, direct-mapped by tet slot and vertex (a miss
   // recomputes; answers do not depend on them). 0: one entry per slot /
   // vertex, never evicted. docs/svrc-design.md §8 item 44.
-  void SetCacheLimits(uint32_t cc_log2, uint32_t memo_log2) {
+  // `neighbor_entries` bounds Delaunay3's neighbour lists
+  // (set_neighbor_cache_limit).
+  void SetCacheLimits(uint32_t cc_log2, uint32_t memo_log2, size_t neighbor_entries) {
+    dt_.set_neighbor_cache_limit(neighbor_entries);
     cc_limit_ = cc_log2 == 0 ? 0 : uint32_t{1} << cc_log2;
     memo_limit_ = memo_log2 == 0 ? 0 : uint32_t{1} << memo_log2;
     cc_.clear();

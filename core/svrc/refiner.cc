@@ -101,7 +101,7 @@ class Refiner {
  public:
   Refiner(const RefineOptions& options, Normalization norm, const Vec3& center, double half)
       : options_(options), norm_(norm), omega_(center, half), pending_(center, half), collar_snap_(options.collar_snap) {
-    omega_.SetCacheLimits(options.omega_cc_log2, options.omega_memo_log2);
+    omega_.SetCacheLimits(options.omega_cc_log2, options.omega_memo_log2, options.omega_neighbor_entries);
   }
 
   absl::Status Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments);
@@ -3316,6 +3316,7 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.size_queries = omega_.stats().size_queries;
   st.sizes_computed = omega_.stats().computed_sizes;
   st.circumcentres = omega_.stats().circumcentres;
+  st.neighbor_cache_flushes = omega_.dt().neighbor_cache_flushes();
 }
 
 PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
@@ -3448,6 +3449,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.size_queries", static_cast<double>(size_queries));
   out->Set("svrc.sizes_computed", static_cast<double>(sizes_computed));
   out->Set("svrc.circumcentres", static_cast<double>(circumcentres));
+  out->Set("svrc.neighbor_cache_flushes", static_cast<double>(neighbor_cache_flushes));
   out->Set("svrc.size_targets_propagated", static_cast<double>(size_targets_propagated));
   out->Set("svrc.sizes_outside", static_cast<double>(sizes_outside));
   out->Set("svrc.sizes_clipped", static_cast<double>(clipped_cells));

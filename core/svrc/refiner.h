@@ -92,6 +92,10 @@ struct RefineOptions {
   // them.
   uint32_t omega_cc_log2 = 20;
   uint32_t omega_memo_log2 = 18;
+  // M_Ω's neighbour lists (Delaunay3's cache, read by the cell searches)
+  // hold about this many entries at most; past it they are all dropped
+  // (§8 item 47). 0: no bound.
+  size_t omega_neighbor_entries = size_t{1} << 20;
   // UpdateLocation drops a shrunk cell's link to a lower ball that lies
   // wholly beyond the bisector of the cell's vertex and the new point, and
   // links the new cell's balls in ball-id order (docs/svrc-design.md §8 item
@@ -269,6 +273,7 @@ struct RefineStats {
   uint64_t size_queries = 0;       // M_Ω Size() calls (and ShrunkSize answers)
   uint64_t sizes_computed = 0;     // ... that walked the star (no memo)
   uint64_t circumcentres = 0;      // M_Ω circumcentres computed (cache misses)
+  uint64_t neighbor_cache_flushes = 0;  // M_Ω's neighbour lists dropped at their bound
   uint64_t size_targets_propagated = 0;  // max_volume targets given between size rounds
   uint64_t sizes_outside = 0;            // cavity cells outside the output, not sized (size_kept_tets)
   uint32_t max_degree = 0;         // Delaunay degree in M_Ω at the end (Thm 2)

@@ -151,6 +151,30 @@ TEST(Delaunay3QueriesTest, CacheFollowsInsertions) {
   EXPECT_TRUE(cached.Validate(true).ok());
 }
 
+// The neighbour cache bounded (set_neighbor_cache_limit): past the limit
+// every list is dropped and the cache starts again. Answers must not change,
+// the flushes must happen, and the pool must stay near the limit.
+TEST(Delaunay3QueriesTest, BoundedCacheFlushesAndAnswersTheSame) {
+  const auto pts = RandomPoints(3000, 26);
+  Delaunay3 cached, plain;
+  cached.set_cache_neighbors(true);
+  cached.set_neighbor_cache_limit(2000);
+  std::mt19937 rng(6);
+  for (uint32_t i = 0; i < pts.size(); ++i) {
+    const auto rc = cached.Insert(pts[i], i);
+    plain.Insert(pts[i], i);
+    if (!cached.Is3d()) continue;
+    std::uniform_int_distribution<uint32_t> pick(0, cached.NumVertices() - 1);
+    for (int k = 0; k < 8; ++k) {
+      const VertexId v = k == 0 ? rc.vertex : VertexId(pick(rng));
+      EXPECT_EQ(ToVector(cached.NeighborsView(v)), ToVector(plain.NeighborsView(v))) << "vertex " << v.value();
+    }
+    if (testing::Test::HasFailure()) return;
+  }
+  ExpectAllMatch(cached);
+  EXPECT_GT(cached.neighbor_cache_flushes(), 5u);
+}
+
 // StarVersion changes exactly for the vertices of new tets, and a vertex
 // whose version did not change answers every query as before.
 TEST(Delaunay3QueriesTest, StarVersionTracksStarChanges) {

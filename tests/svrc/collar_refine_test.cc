@@ -495,7 +495,8 @@ TEST(CollarRefine, LabellingWithTheMeshAdjacencyMakesTheSameRefinement) {
 // M_Ω's circumcentre cache and Size() memos bounded and direct-mapped
 // (RefineOptions::omega_cc_log2 / omega_memo_log2, §8 item 44): tables of
 // 64 circumcentres and 16 memos, where nearly every lookup meets another
-// tet's or vertex's record, against one record per slot and vertex. The
+// tet's or vertex's record, against one record per slot and vertex; and
+// the neighbour lists dropped whenever they pass 256 entries (§8 item 47). The
 // same refinement bit for bit, on the collar path (knife_edge, segment_fan)
 // and with size rounds; a record answering for the wrong tet or vertex, or
 // a ShrunkSize on an evicted memo, changes it.
@@ -507,7 +508,10 @@ TEST(CollarRefine, BoundedOmegaCachesMakeTheSameRefinement) {
     const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
       o->omega_cc_log2 = on ? 6 : 0;
       o->omega_memo_log2 = on ? 4 : 0;
+      o->omega_neighbor_entries = on ? 256 : 0;
     });
+    EXPECT_EQ(runs[0].stats.neighbor_cache_flushes, 0u) << c.rel;
+    EXPECT_GT(runs[1].stats.neighbor_cache_flushes, 10u) << c.rel;
     EXPECT_GT(runs[1].stats.circumcentres, 2 * runs[0].stats.circumcentres) << c.rel;
     EXPECT_GT(runs[1].stats.sizes_computed, runs[0].stats.sizes_computed) << c.rel;
     EXPECT_GT(runs[1].stats.sizes_shrunk, 0u) << c.rel;

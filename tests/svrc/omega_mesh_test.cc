@@ -37,8 +37,8 @@ struct Counts {
 Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool labelled = false, uint32_t cc_log2 = 0,
                     uint32_t memo_log2 = 0) {
   OmegaMesh a(Vec3{0.5, 0.5, 0.5}, 2.0), b(Vec3{0.5, 0.5, 0.5}, 2.0);
-  a.SetCacheLimits(cc_log2, memo_log2);
-  b.SetCacheLimits(0, 0);
+  a.SetCacheLimits(cc_log2, memo_log2, size_t{1} << 20);
+  b.SetCacheLimits(0, 0, 0);
   util::PodVector<TetLabel> labels;
   if (labelled) {
     a.SetLabels(&labels);
