@@ -659,24 +659,36 @@ void Delaunay3::set_cache_neighbors(bool on) {
   adj_.shrink_to_fit();
   adj_pool_.clear();
   adj_pool_.shrink_to_fit();
+  adj_stored_.clear();
   adj_live_ = 0;
+}
+
+void Delaunay3::set_neighbor_cache_limit(size_t entries) {
+  adj_limit_ = entries;
+  set_cache_neighbors(cache_neighbors_);  // the lists so far are not in adj_stored_
 }
 
 // Appends nbr_buf_[0, m) to the pool as v's list. When the pool is full it
 // is rebuilt with only the live lists (in vertex order) and room for half as
 // many again: copying is amortised over at least live/2 appends, and the pool
 // never holds more than ~1.5× the live lists (~3× while being rebuilt).
-// Beyond adj_limit_ live entries every list is dropped instead: the pool then
-// stays within ~1.5× the limit (a run with 10^7 vertices held ~10^8 entries).
+// With a limit (adj_limit_ != 0) the pool is never rebuilt: when it would
+// pass the limit every list stored since the last flush is dropped, through
+// the list of those vertices (adj_stored_), so a flush costs what the stores
+// since the last one did, not a pass over every vertex (a run with 10^7
+// vertices had held ~10^8 entries).
 void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
   if (adj_.size() <= v) util::GrowExactly(adj_, points_.size() + points_.size() / 2 + 16);
-  if (adj_pool_.size() + m > adj_pool_.capacity() && adj_limit_ != 0 && adj_live_ + m > adj_limit_) {
-    for (AdjEntry& e : adj_) e.size = kNoAdj;
-    adj_pool_.clear();
-    adj_live_ = 0;
-    ++adj_flushes_;
-  }
-  if (adj_pool_.size() + m > adj_pool_.capacity()) {
+  if (adj_limit_ != 0) {
+    if (adj_pool_.size() + m > adj_limit_ || adj_stored_.size() >= adj_limit_) {
+      for (uint32_t w : adj_stored_) adj_[w].size = kNoAdj;
+      adj_stored_.clear();
+      adj_pool_.clear();
+      adj_live_ = 0;
+      ++adj_flushes_;
+    }
+    adj_stored_.push_back(v);
+  } else if (adj_pool_.size() + m > adj_pool_.capacity()) {
     std::vector<VertexId> pool;
     pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);
     for (AdjEntry& e : adj_) {

@@ -109,11 +109,11 @@ class Delaunay3 {
   // star, its VertexTet and hence its answer (same contents, same order).
   // Costs ~8 bytes per vertex plus the lists.
   void set_cache_neighbors(bool on);
-  // The lists hold at most about this many entries (0: no bound): when the
-  // pool fills with more live entries than that, every list is dropped
-  // instead of the pool being rebuilt (the cache starts again; answers do
-  // not change). Default 2^20 (4 MB of lists).
-  void set_neighbor_cache_limit(size_t entries) { adj_limit_ = entries; }
+  // The lists hold at most this many entries (0: no bound, the pool is
+  // rebuilt with the live lists when full): when the pool would pass it,
+  // every list is dropped (the cache starts again; answers do not change).
+  // Default 2^20 (4 MB of lists). Drops every list cached so far.
+  void set_neighbor_cache_limit(size_t entries);
   // Lists dropped that way (cache flushes), for tests.
   uint64_t neighbor_cache_flushes() const { return adj_flushes_; }
 
@@ -326,6 +326,7 @@ class Delaunay3 {
   mutable std::vector<VertexId> adj_pool_;
   mutable size_t adj_live_ = 0;  // entries of adj_pool_ still referenced
   size_t adj_limit_ = size_t{1} << 20;
+  mutable std::vector<uint32_t> adj_stored_;  // with a limit: vertices stored since the last flush
   mutable uint64_t adj_flushes_ = 0;
   bool report_cavity_vertices_ = true;
   Stats stats_;
