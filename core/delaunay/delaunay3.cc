@@ -672,23 +672,43 @@ void Delaunay3::set_neighbor_cache_limit(size_t entries) {
 // is rebuilt with only the live lists (in vertex order) and room for half as
 // many again: copying is amortised over at least live/2 appends, and the pool
 // never holds more than ~1.5× the live lists (~3× while being rebuilt).
-// With a limit (adj_limit_ != 0) the pool is never rebuilt: when it would
-// pass the limit every list stored since the last flush is dropped, through
-// the list of those vertices (adj_stored_), so a flush costs what the stores
-// since the last one did, not a pass over every vertex (a run with 10^7
-// vertices had held ~10^8 entries).
+// With a limit (adj_limit_ != 0) the vertices stored since the last flush
+// are listed (adj_stored_), and a full pool is rebuilt from that list, not
+// from a pass over every vertex; when the live lists would pass the limit,
+// every list on it is dropped instead (a flush). Both cost what the stores
+// since the last rebuild did (a run with 10^7 vertices had held ~10^8
+// entries; a pass over all of them per rebuild is 10^3 passes over 10^7
+// vertices on such a run).
 void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
   if (adj_.size() <= v) util::GrowExactly(adj_, points_.size() + points_.size() / 2 + 16);
-  if (adj_limit_ != 0) {
-    if (adj_pool_.size() + m > adj_limit_ || adj_stored_.size() >= adj_limit_) {
+  if (adj_limit_ != 0 && adj_pool_.size() + m > adj_pool_.capacity()) {
+    if (adj_live_ + m > adj_limit_) {
       for (uint32_t w : adj_stored_) adj_[w].size = kNoAdj;
       adj_stored_.clear();
       adj_pool_.clear();
       adj_live_ = 0;
       ++adj_flushes_;
+    } else {
+      // A vertex may be listed twice (stored, invalidated, stored again):
+      // kCopied marks the lists already moved.
+      constexpr uint32_t kCopied = 0x80000000u;
+      std::vector<VertexId> pool;
+      pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);
+      std::vector<uint32_t> stored;
+      for (uint32_t w : adj_stored_) {
+        AdjEntry& e = adj_[w];
+        if (e.size == kNoAdj || (e.size & kCopied) != 0) continue;
+        const uint32_t off = static_cast<uint32_t>(pool.size());
+        pool.insert(pool.end(), adj_pool_.begin() + e.offset, adj_pool_.begin() + e.offset + e.size);
+        e.offset = off;
+        e.size |= kCopied;
+        stored.push_back(w);
+      }
+      for (uint32_t w : stored) adj_[w].size &= ~kCopied;
+      adj_pool_.swap(pool);
+      adj_stored_.swap(stored);
     }
-    adj_stored_.push_back(v);
-  } else if (adj_pool_.size() + m > adj_pool_.capacity()) {
+  } else if (adj_limit_ == 0 && adj_pool_.size() + m > adj_pool_.capacity()) {
     std::vector<VertexId> pool;
     pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);
     for (AdjEntry& e : adj_) {
@@ -699,6 +719,7 @@ void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
     }
     adj_pool_.swap(pool);
   }
+  if (adj_limit_ != 0) adj_stored_.push_back(v);
   AdjEntry& e = adj_[v];
   e.offset = static_cast<uint32_t>(adj_pool_.size());
   e.size = m;
