@@ -109,10 +109,11 @@ class Delaunay3 {
   // star, its VertexTet and hence its answer (same contents, same order).
   // Costs ~8 bytes per vertex plus the lists.
   void set_cache_neighbors(bool on);
-  // The lists hold at most this many entries (0: no bound, the pool is
-  // rebuilt with the live lists when full): when the pool would pass it,
-  // every list is dropped (the cache starts again; answers do not change).
-  // Default 2^20 (4 MB of lists). Drops every list cached so far.
+  // The live lists hold at most this many entries (0: no bound): a full
+  // pool is rebuilt with the live lists, and when those would pass the
+  // bound every list is dropped instead (the cache starts again; answers do
+  // not change). Default 2^20 (4 MB of lists). Drops every list cached so
+  // far.
   void set_neighbor_cache_limit(size_t entries);
   // Lists dropped that way (cache flushes), for tests.
   uint64_t neighbor_cache_flushes() const { return adj_flushes_; }
