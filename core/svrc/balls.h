@@ -103,7 +103,7 @@ class BallStore {
   };
   static_assert(sizeof(Record) == 64);
   util::PodVector<Record> rec_;
-  std::vector<MeshId> mesh_;  // rarely read
+  util::PodVector<MeshId> mesh_;  // rarely read
   uint32_t num_alive_ = 0;
 };
 

@@ -122,7 +122,7 @@ void LocationGraph::MaybeCompactCells() {
 
 void LocationGraph::MaybeCompactObjects() {
   std::vector<Span*> spans;
-  for (std::vector<Span>* list : {&ball_spans_, &collar_spans_}) {
+  for (util::PodVector<Span>* list : {&ball_spans_, &collar_spans_}) {
     for (Span& s : *list) {
       if (s.cap != 0) spans.push_back(&s);
     }
@@ -161,7 +161,7 @@ void LocationGraph::LeaveUnresolved(MeshId mesh, CellSpanT& cs) {
 }
 
 inline LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
-  std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
+  util::PodVector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
   if (spans.size() <= object.id) [[unlikely]] {
     util::ReserveForAppend(spans, object.id + 1 - spans.size());
     spans.resize(object.id + 1);
@@ -170,7 +170,7 @@ inline LocationGraph::Span& LocationGraph::ObjectSpan(LocationObject object) {
 }
 
 inline const LocationGraph::Span* LocationGraph::FindObjectSpan(LocationObject object) const {
-  const std::vector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
+  const util::PodVector<Span>& spans = object.kind == ObjectKind::kBall ? ball_spans_ : collar_spans_;
   return spans.size() <= object.id ? nullptr : &spans[object.id];
 }
 
@@ -386,7 +386,7 @@ bool LocationGraph::Validate() const {
   // array holds the object exactly once.
   uint64_t object_count = 0;
   for (int kind = 0; kind < 2; ++kind) {
-    const std::vector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
+    const util::PodVector<Span>& spans = kind == 0 ? ball_spans_ : collar_spans_;
     for (uint32_t id = 0; id < spans.size(); ++id) {
       const Span& os = spans[id];
       if (os.size > os.cap) return false;

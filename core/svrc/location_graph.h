@@ -249,8 +249,8 @@ class LocationGraph {
   uint32_t num_links_ = 0;
   std::vector<util::PodVector<CellSpanT>> cell_spans_;  // [mesh][cell]
   std::vector<std::vector<uint32_t>> unresolved_cells_;  // [mesh]: cells with unresolved > 0
-  std::vector<Span> ball_spans_;
-  std::vector<Span> collar_spans_;
+  util::PodVector<Span> ball_spans_;
+  util::PodVector<Span> collar_spans_;
   Stats stats_;
 };
 

@@ -10,6 +10,7 @@
 #include "core/geometry/vec3.h"
 #include "core/svrc/containment.h"
 #include "core/svrc/ids.h"
+#include "core/util/pod_vector.h"
 
 namespace svrc::refine {
 
@@ -39,12 +40,12 @@ class PointStore {
     uint32_t vertex;
     uint32_t next;
   };
-  std::vector<geom::Vec3> xyz_;
-  std::vector<FeatureId> parent_;
-  std::vector<Cd> cd_;
-  std::vector<uint8_t> crease_;
-  std::vector<uint32_t> member_head_;
-  std::vector<Membership> members_;  // a singly-linked list per point; few entries each
+  util::PodVector<geom::Vec3> xyz_;
+  util::PodVector<FeatureId> parent_;
+  util::PodVector<Cd> cd_;
+  util::PodVector<uint8_t> crease_;
+  util::PodVector<uint32_t> member_head_;
+  util::PodVector<Membership> members_;  // a singly-linked list per point; few entries each
 };
 
 }  // namespace svrc::refine

@@ -541,16 +541,16 @@ class Refiner {
   std::vector<uint32_t> seg_input_a_;  // input endpoint at t = 0 of each segment
   uint32_t num_input_ = 0;
   std::vector<uint32_t> duplicate_of_;  // first input point with the same coordinates
-  std::vector<BallId> vertex_ball_;     // per global point: its 0-ball (kNoneBall: none)
-  std::vector<uint32_t> piece_vertex_;  // per ball: local vertex starting its piece
-  std::vector<uint32_t> piece_seg_;     // per ball: its segment
+  util::PodVector<BallId> vertex_ball_;     // per global point: its 0-ball (kNoneBall: none)
+  util::PodVector<uint32_t> piece_vertex_;  // per ball: local vertex starting its piece
+  util::PodVector<uint32_t> piece_seg_;     // per ball: its segment
   // Facets (stage (c)).
   std::vector<FacetMesh> facets_;
   std::vector<plc::FacetFrame> frames_;  // normalised frames
   uint32_t facet_mesh0_ = 0;             // MeshId of facet 0 (= its FeatureId)
   std::vector<std::vector<uint32_t>> point_facets_;  // per complex point: facets containing it
   std::vector<std::vector<uint32_t>> seg_facets_;    // per segment: facets containing it
-  std::vector<uint32_t> tri_of_ball_;    // per triangle ball: its M_F triangle slot
+  util::PodVector<uint32_t> tri_of_ball_;    // per triangle ball: its M_F triangle slot
   std::vector<uint32_t> facet_input_;    // per facet: index in Plc::facets
   std::vector<int32_t> facet_marker_;
   CellSize2 last_size2_;
