@@ -663,26 +663,19 @@ void Delaunay3::set_cache_neighbors(bool on) {
   adj_live_ = 0;
 }
 
-void Delaunay3::set_neighbor_cache_limit(size_t entries) {
-  adj_limit_ = entries;
-  set_cache_neighbors(cache_neighbors_);  // the lists so far are not in adj_stored_
-}
-
-// Appends nbr_buf_[0, m) to the pool as v's list. When the pool is full it
-// is rebuilt with only the live lists (in vertex order) and room for half as
-// many again: copying is amortised over at least live/2 appends, and the pool
-// never holds more than ~1.5× the live lists (~3× while being rebuilt).
-// With a limit (adj_limit_ != 0) the vertices stored since the last flush
-// are listed (adj_stored_), and a full pool is rebuilt from that list, not
-// from a pass over every vertex; when the live lists would pass the limit,
-// every list on it is dropped instead (a flush). Both cost what the stores
-// since the last rebuild did (a run with 10^7 vertices had held ~10^8
-// entries; a pass over all of them per rebuild is 10^3 passes over 10^7
-// vertices on such a run).
+// Appends nbr_buf_[0, m) to the pool as v's list. The vertices stored since
+// the last flush are listed (adj_stored_). When the pool is full it is
+// rebuilt from that list with only the live lists and room for half as many
+// again: copying is amortised over at least live/2 appends, and the pool
+// never holds more than ~1.5× the live lists (~3× while being rebuilt). With
+// a limit (adj_limit_ != 0), when the live lists would pass it every list on
+// the list is dropped instead (a flush). Both cost what the stores since the
+// last rebuild did, not a pass over every vertex (a run with 10^7 vertices
+// had held ~10^8 entries: 10^3 passes over 10^7 vertices).
 void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
   if (adj_.size() <= v) util::GrowExactly(adj_, points_.size() + points_.size() / 2 + 16);
-  if (adj_limit_ != 0 && adj_pool_.size() + m > adj_pool_.capacity()) {
-    if (adj_live_ + m > adj_limit_) {
+  if (adj_pool_.size() + m > adj_pool_.capacity()) {
+    if (adj_limit_ != 0 && adj_live_ + m > adj_limit_) {
       for (uint32_t w : adj_stored_) adj_[w].size = kNoAdj;
       adj_stored_.clear();
       adj_pool_.clear();
@@ -708,18 +701,8 @@ void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
       adj_pool_.swap(pool);
       adj_stored_.swap(stored);
     }
-  } else if (adj_limit_ == 0 && adj_pool_.size() + m > adj_pool_.capacity()) {
-    std::vector<VertexId> pool;
-    pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);
-    for (AdjEntry& e : adj_) {
-      if (e.size == kNoAdj) continue;
-      const uint32_t off = static_cast<uint32_t>(pool.size());
-      pool.insert(pool.end(), adj_pool_.begin() + e.offset, adj_pool_.begin() + e.offset + e.size);
-      e.offset = off;
-    }
-    adj_pool_.swap(pool);
   }
-  if (adj_limit_ != 0) adj_stored_.push_back(v);
+  adj_stored_.push_back(v);
   AdjEntry& e = adj_[v];
   e.offset = static_cast<uint32_t>(adj_pool_.size());
   e.size = m;

@@ -112,9 +112,8 @@ class Delaunay3 {
   // The live lists hold at most this many entries (0: no bound): a full
   // pool is rebuilt with the live lists, and when those would pass the
   // bound every list is dropped instead (the cache starts again; answers do
-  // not change). Default 2^20 (4 MB of lists). Drops every list cached so
-  // far.
-  void set_neighbor_cache_limit(size_t entries);
+  // not change). Default 2^20 (4 MB of lists).
+  void set_neighbor_cache_limit(size_t entries) { adj_limit_ = entries; }
   // Lists dropped that way (cache flushes), for tests.
   uint64_t neighbor_cache_flushes() const { return adj_flushes_; }
 
@@ -327,7 +326,7 @@ class Delaunay3 {
   mutable std::vector<VertexId> adj_pool_;
   mutable size_t adj_live_ = 0;  // entries of adj_pool_ still referenced
   size_t adj_limit_ = size_t{1} << 20;
-  mutable std::vector<uint32_t> adj_stored_;  // with a limit: vertices stored since the last flush
+  mutable std::vector<uint32_t> adj_stored_;  // vertices stored since the last flush (StoreAdj)
   mutable uint64_t adj_flushes_ = 0;
   bool report_cavity_vertices_ = true;
   Stats stats_;

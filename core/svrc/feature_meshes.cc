@@ -59,6 +59,26 @@ size_t CacheSize(size_t n, uint32_t limit) {
   const size_t want = std::bit_ceil(std::max<size_t>(n, 64));
   return limit == 0 ? want : std::min<size_t>(want, limit);
 }
+
+// Grows a direct-mapped table to CacheSize(n, limit) records when `key` (the
+// index looked up) lies beyond it and the limit allows; the records move to
+// their new places (a record's place is its key's low bits; the new places
+// of the old records are distinct, each its old place or one beyond the old
+// table). key_of(record) is its key, or `none` for an empty record.
+template <typename R, typename KeyOf>
+void GrowTable(util::PodVector<R>& table, uint32_t key, size_t n, uint32_t limit, uint32_t none, KeyOf key_of) {
+  if (table.size() > key || (limit != 0 && table.size() >= limit)) return;
+  const size_t old_size = table.size();
+  const size_t size = CacheSize(n, limit);
+  table.resize(size, R{});
+  const size_t mask = size - 1;
+  for (size_t k = 0; k < old_size; ++k) {
+    const uint32_t w = key_of(table[k]);
+    if (w == none || (w & mask) == k) continue;
+    table[w & mask] = table[k];
+    table[k] = R{};
+  }
+}
 }  // namespace
 
 OmegaMesh::CcEntry OmegaMesh::ComputeCircumcenter(TetId t) const {
@@ -81,21 +101,8 @@ OmegaMesh::CcEntry OmegaMesh::ComputeCircumcenter(TetId t) const {
 OmegaMesh::CcEntry OmegaMesh::CachedCircumcenter(TetId t) const {
   const uint32_t i = t.value();
   if (i > CcRecord::kSlotMask) [[unlikely]] return ComputeCircumcenter(t);
-  if (cc_.size() <= i && (cc_limit_ == 0 || cc_.size() < cc_limit_)) {
-    // Grown: the records move to their new places (a record's place is its
-    // slot's low bits; the new places of the old records are distinct, and
-    // each is its old place or one beyond the old table).
-    const size_t old_size = cc_.size();
-    const size_t n = CacheSize(size_t{dt_.TetCapacity()} + 64, cc_limit_);
-    cc_.resize(n, CcRecord{});
-    const size_t mask = n - 1;
-    for (size_t k = 0; k < old_size; ++k) {
-      const uint32_t s = cc_[k].tag & CcRecord::kSlotMask;
-      if (s == CcRecord::kSlotMask || (s & mask) == k) continue;
-      cc_[s & mask] = cc_[k];
-      cc_[k] = CcRecord{};
-    }
-  }
+  GrowTable(cc_, i, size_t{dt_.TetCapacity()} + 64, cc_limit_, CcRecord::kSlotMask,
+            [](const CcRecord& r) { return r.tag & CcRecord::kSlotMask; });
   const uint32_t g = dt_.Generation(t) + 1;
   CcRecord& r = cc_[i & (cc_.size() - 1)];
   if ((r.tag & CcRecord::kSlotMask) == i && r.gen == g) {
@@ -163,18 +170,11 @@ void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* sc
 
 OmegaMesh::SizeMemo* OmegaMesh::MemoSlot(VertexId v, bool grow) const {
   const uint32_t i = v.value();
-  if (size_memo_.size() <= i && (memo_limit_ == 0 || size_memo_.size() < memo_limit_)) {
-    if (!grow) return nullptr;
-    const size_t old_size = size_memo_.size();
-    const size_t n = CacheSize(size_t{dt_.NumVertices()} + dt_.NumVertices() / 2 + 16, memo_limit_);
-    size_memo_.resize(n, SizeMemo{});
-    const size_t mask = n - 1;
-    for (size_t k = 0; k < old_size; ++k) {
-      const uint32_t w = size_memo_[k].vertex;
-      if (w == 0xFFFFFFFFu || (w & mask) == k) continue;
-      size_memo_[w & mask] = size_memo_[k];
-      size_memo_[k] = SizeMemo{};
-    }
+  if (grow) {
+    GrowTable(size_memo_, i, size_t{dt_.NumVertices()} + dt_.NumVertices() / 2 + 16, memo_limit_, 0xFFFFFFFFu,
+              [](const SizeMemo& m) { return m.vertex; });
+  } else if (size_memo_.size() <= i && (memo_limit_ == 0 || size_memo_.size() < memo_limit_)) {
+    return nullptr;  // a table that would still grow to reach v holds no memo of it
   }
   return &size_memo_[i & (size_memo_.size() - 1)];
 }
