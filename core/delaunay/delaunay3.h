@@ -107,7 +107,8 @@ class Delaunay3 {
   // insertions (SVRC's cell searches on M_Ω). An insertion invalidates
   // exactly the vertices of the new tets: a vertex in no new tet keeps its
   // star, its VertexTet and hence its answer (same contents, same order).
-  // Costs ~8 bytes per vertex plus the lists.
+  // Costs ~8 bytes per vertex plus the lists (and 4 per list stored since
+  // the last flush).
   void set_cache_neighbors(bool on);
   // The live lists hold at most this many entries (0: no bound): a full
   // pool is rebuilt with the live lists, and when those would pass the
