@@ -210,8 +210,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
       return absl::OkStatus();
     };
   }
-  options.progress = [&](uint64_t vertices, uint64_t queue, double radius) {
-    report("refine", vertices, queue, radius);
+  options.progress = [&](const char* phase, uint64_t vertices, uint64_t queue, double radius) {
+    report(phase, vertices, queue, radius);
   };
   report("refine", 0, 0, 0);
   // Creases (Definitions 4-5). Mild ones (>= kCollarAngleDeg) are refined

@@ -45,7 +45,9 @@ struct MeshParams {
 
 // A snapshot of progress, reported from the meshing thread.
 struct Progress {
-  std::string phase;                 // "read", "validate", "refine", "stitch", ...
+  // "validate", "refine", with creases "collar", "stitch", "stitch-repair"
+  // (refine::refine_phase), then "assemble", "check", "done".
+  std::string phase;
   uint64_t vertices = 0;             // vertices in the output mesh so far
   uint64_t queue_size = 0;           // pending work events
   double largest_work_radius = 0;    // radius of the largest pending gap ball

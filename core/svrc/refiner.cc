@@ -371,9 +371,16 @@ class Refiner {
       absl::Status s = options_.poll();
       if (!s.ok()) return s;
     }
-    if (options_.progress) options_.progress(TotalVertices(), queues_.size(), radius);
+    if (options_.progress) options_.progress(phase_, TotalVertices(), queues_.size(), radius);
     return absl::OkStatus();
   }
+  // The stage RefinePlc is in (refine_phase), reported once as it begins and
+  // then at every poll.
+  void EnterPhase(const char* phase) {
+    phase_ = phase;
+    if (options_.progress) options_.progress(phase_, TotalVertices(), queues_.size(), 0);
+  }
+  const char* phase_ = refine_phase::kRefine;
   // RipStitchCollar (Figure 3.12) on the final M_Ω; fills stitched_.
   absl::Status Stitch() { return StitchImpl(); }
   void ClearStitch() {
@@ -3703,6 +3710,7 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
     // Measured: crease_pair 30° settles in 16 rounds, 10° in 104, 5° in 87.
     constexpr int kMaxCollarRounds = 256;
     bool settled = false;
+    refiner.EnterPhase(refine_phase::kCollar);
     for (int round = 0; round < kMaxCollarRounds; ++round) {
       absl::StatusOr<bool> more = refiner.CollarRound();
       if (!more.ok()) {
@@ -3740,12 +3748,15 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   s = refiner.VerifyConformity();
   if (!s.ok()) return s;
   if (!(options.collars && options.collar_surface && refiner.collars().size() > 0)) break;
+  refiner.EnterPhase(refine_phase::kStitch);
   s = refiner.Stitch();
   if (!s.ok()) {
+    refiner.EnterPhase(refine_phase::kStitchRepair);
     absl::StatusOr<uint32_t> fixed = refiner.RepairStitchFailures();
     if (!fixed.ok()) return fixed.status();
     if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
-      std::fprintf(stderr, "stitch failed: %u inverted stars repaired\n", *fixed);
+      std::fprintf(stderr, "stitch failed (%s): %u inverted stars repaired\n", std::string(s.message()).c_str(),
+                   *fixed);
     }
     if (*fixed == 0 || ++stitch_repair_passes == 8) return s;
     s = refiner.Run();
@@ -3759,6 +3770,7 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
                  refiner.stitched_arc_crossings_);
   }
   if (*crossings > 0) {
+    refiner.EnterPhase(refine_phase::kStitchRepair);
     if (++crossing_passes == 8) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: the stitched mesh still crosses the facets next to "
                                                        "the collars after 8 passes (", *crossings, " crossings left)"));
@@ -3779,6 +3791,7 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   }
   refiner.CountSizeRound();
   refiner.ClearStitch();
+  refiner.EnterPhase(refine_phase::kRefine);
   s = refiner.Run();
   if (!s.ok()) return s;
   }

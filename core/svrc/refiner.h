@@ -24,6 +24,18 @@
 
 namespace svrc::refine {
 
+// The stages of RefinePlc as progress reports name them (Progress::phase):
+// the first refinement and the size and quality rounds; the COLLAR rounds
+// (thesis §3.2.2) with the refinement their points set off; RipStitchCollar
+// (Figure 3.12); the points a failed stitch or a stitched mesh crossing a
+// facet asks for, and their refinement.
+namespace refine_phase {
+inline constexpr const char* kRefine = "refine";
+inline constexpr const char* kCollar = "collar";
+inline constexpr const char* kStitch = "stitch";
+inline constexpr const char* kStitchRepair = "stitch-repair";
+}  // namespace refine_phase
+
 struct RefineOptions {
   // Voronoi aspect-ratio bound τ (R_v/r_v ≤ τ at the end); the API's
   // radius_edge is τ/2 (docs/svrc-design.md §4).
@@ -196,9 +208,10 @@ struct RefineOptions {
   // docs/svrc-collars.md "Session 11".
   double collar_snap = 0;
   double collar_snap_fallback = 0.02;
-  // Called at every poll: vertices in all meshes, pending events, radius of
-  // the event about to be destroyed (the largest work radius). May be null.
-  std::function<void(uint64_t vertices, uint64_t queue, double radius)> progress;
+  // Called at every poll: the stage of RefinePlc (RefinePhase), vertices in
+  // all meshes, pending events, radius of the event about to be destroyed
+  // (the largest work radius); and once as each stage begins. May be null.
+  std::function<void(const char* phase, uint64_t vertices, uint64_t queue, double radius)> progress;
   // > 0: check the stage-(a) invariants (guide §6 (a)) every that many
   // insertions, and always at the end. For tests; costs O(n·m) per check.
   uint32_t validate_every = 0;

@@ -879,7 +879,7 @@ TEST(CollarRefine, CollarRoundsPollBetweenRepairs) {
     ++polls;
     return absl::OkStatus();
   };
-  opt.progress = [&](uint64_t vertices, uint64_t, double) {
+  opt.progress = [&](const char*, uint64_t vertices, uint64_t, double) {
     if (last > 0) max_gap = std::max(max_gap, vertices - std::min(vertices, last));
     last = vertices;
   };

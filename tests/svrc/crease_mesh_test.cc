@@ -127,6 +127,56 @@ TEST(CreaseMesh, FacetPair30) {
   MeshAndCheck(plc::families::CreaseFacetPair(30), "crease_pair_30");
 }
 
+// The progress reports name the stage the run is in (refine::refine_phase),
+// so whoever watches a long creased job sees the COLLAR rounds, the stitch
+// and the repairs after it apart (session 18's armadillo.off run printed
+// "refine" for an hour of all of them). The stages come in their order; the
+// vertex count never falls; a run without creases has no collar stage.
+std::vector<std::string> PhasesOf(const plc::Plc& plc, bool* vertices_monotone) {
+  std::vector<std::string> phases;
+  uint64_t last = 0;
+  *vertices_monotone = true;
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(plc, {}, [&](const core::Progress& p) {
+    if (phases.empty() || phases.back() != p.phase) phases.push_back(p.phase);
+    // The refiner's count (all meshes) until the output's, which is smaller.
+    if (p.phase != "assemble" && p.phase != "check" && p.phase != "done") {
+      *vertices_monotone = *vertices_monotone && p.vertices >= last;
+      last = p.vertices;
+    }
+  });
+  EXPECT_TRUE(m.ok()) << m.status();
+  return phases;
+}
+
+TEST(CreaseMesh, ProgressNamesTheCollarStages) {
+  bool monotone = false;
+  const std::vector<std::string> phases = PhasesOf(plc::families::CreaseFacetPair(30), &monotone);
+  EXPECT_TRUE(monotone);
+  std::string seq;
+  for (const std::string& p : phases) seq += p + " ";
+  ASSERT_GE(phases.size(), 7u) << seq;
+  EXPECT_EQ(phases[0], "validate") << seq;
+  EXPECT_EQ(phases[1], "refine") << seq;
+  EXPECT_EQ(phases[2], "collar") << seq;
+  const size_t n = phases.size();
+  EXPECT_EQ(phases[n - 4], "stitch") << seq;
+  EXPECT_EQ(phases[n - 3], "assemble") << seq;
+  EXPECT_EQ(phases[n - 2], "check") << seq;
+  EXPECT_EQ(phases[n - 1], "done") << seq;
+  // Between: the stitch, a repair and the rounds again, as often as needed.
+  for (size_t i = 2; i + 4 < n; ++i) {
+    const std::string next = phases[i] == "collar"   ? "stitch"
+                             : phases[i] == "stitch" ? "stitch-repair"
+                                                     : "collar";
+    EXPECT_EQ(phases[i + 1], next) << i << ": " << seq;
+  }
+  std::printf("crease_pair_30 phases: %s\n", seq.c_str());
+
+  const std::vector<std::string> plain = PhasesOf(plc::families::BoxWithInternalFacets(1), &monotone);
+  EXPECT_TRUE(monotone);
+  EXPECT_EQ(plain, (std::vector<std::string>{"validate", "refine", "assemble", "done"}));
+}
+
 // 10°: settles in ~100 COLLAR rounds only without the chord check (with it
 // the same 28 chords were re-inserted every round until the round limit).
 TEST(CreaseMesh, FacetPair10) {
