@@ -526,7 +526,9 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
 
 std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescription& collars,
                                         const CollarSurfaceOptions& opt,
-                                        CollarSurfaceReport* report, CollarRestrictionCache* cache) {
+                                        CollarSurfaceReport* report, CollarRestrictionCache* cache,
+                                        std::vector<RestrictedTriangle>* triangles) {
+  if (triangles != nullptr) triangles->clear();
   CollarSurfaceReport rep;
   std::vector<CollarRepair> out;
   const std::span<const CollarBall> balls(collars.balls);
@@ -538,7 +540,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     if (report != nullptr) *report = rep;
     return out;
   }
-  const CollarRestriction res = ComputeCollarRestriction(dt, collars, opt, cache);
+  CollarRestriction res = ComputeCollarRestriction(dt, collars, opt, cache);
   const BallGrid grid(balls);
   for (uint32_t c : res.candidates_per_ball) rep.candidates += c;
   const std::vector<RestrictedTriangle>& tris = res.triangles;
@@ -1037,6 +1039,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
   });
   for (const CollarRepair& r : merged) ++rep.repairs[r.reason];
   if (report != nullptr) *report = std::move(rep);
+  if (triangles != nullptr) *triangles = std::move(res.triangles);
   return merged;
 }
 

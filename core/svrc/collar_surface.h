@@ -187,10 +187,14 @@ double CollarSurfaceSize(const Vec3& x, const CollarDescription& collars);
 // (a collar-consistent sample, as far as these tests see) and every
 // representation angle is ≤ σ (with size_criterion: every RepBall radius is
 // ≤ ε_s·css(x) instead of the angle bound). `report` may be null.
+// `triangles`, when not null, receives the restricted triangles the tests
+// read (CollarRestriction::triangles), so a caller need not compute them
+// again.
 std::vector<CollarRepair> CollarRepairs(const delaunay::Delaunay3& dt,
                                         const CollarDescription& collars,
                                         const CollarSurfaceOptions& opt,
                                         CollarSurfaceReport* report,
-                                        CollarRestrictionCache* cache = nullptr);
+                                        CollarRestrictionCache* cache = nullptr,
+                                        std::vector<RestrictedTriangle>* triangles = nullptr);
 
 }  // namespace svrc::refine

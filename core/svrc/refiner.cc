@@ -590,6 +590,7 @@ class Refiner {
   StitchResult stitch_report_;
   double collar_snap_ = 0;  // the COLLAR rounds' snap band (RefineOptions::collar_snap, then its fallback)
   CollarSurfaceReport surface_report_;
+  bool topology_held_ = false;  // some COLLAR round had no topology or circle repair
   uint32_t collar_rounds_ = 0, collar_repairs_ = 0, arc_repairs_ = 0, crossing_count_ = 0;
   std::array<uint64_t, 4> collar_repairs_by_reason_{};  // by CollarRepair::Reason
   // The COLLAR rounds' restricted Delaunay of S, per ball, reused across
@@ -2324,7 +2325,8 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     restriction_cache_.generation = [this](uint32_t v) { return omega_.CellGeneration(VertexId(v)); };
   }
   CollarRestrictionCache* cache = options_.reuse_round_work ? &restriction_cache_ : nullptr;
-  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_, cache);
+  std::vector<RestrictedTriangle> restricted;
+  std::vector<CollarRepair> reps = CollarRepairs(omega_.dt(), desc, copt, &surface_report_, cache, &restricted);
   // A crease vertex must be strictly inside the stitched hole (Figure 3.12:
   // its star replaces the inside): every tet around it needs its
   // circumcentre inside the collars. A tet whose circumcentre is outside
@@ -2367,14 +2369,21 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   bool any = false;
   const delaunay::Delaunay3& dt = omega_.dt();
   std::vector<std::pair<uint32_t, Vec2>> crossings;  // (facet, arc point uv) of this round
-  if (reps.empty()) {
-    const CollarRestriction restr = ComputeCollarRestriction(dt, desc, copt, cache);
+  // The facet-crossing check (below) once the restricted triangulation's
+  // topology has held in some round (no topology or circle repair): from
+  // then on every round, so its arc points go in with the angle repairs
+  // instead of each batch restarting rounds that had settled.
+  if (surface_report_.repairs[CollarRepair::kTopology] == 0 && surface_report_.repairs[CollarRepair::kCircle] == 0) {
+    topology_held_ = true;
+  }
+  const bool check_crossings = reps.empty() || (options_.crossings_once_topology_holds && topology_held_);
+  if (check_crossings) {
     // Facet-crossing check: RipStitchCollar's fan (centre, a, b) covers a
     // facet F through a collar centre only if T′ meets F along F's own points.
     // A T′ edge of ball i's partial sphere whose ends are strictly on opposite
     // sides of such an F (inside F's region) gets F's arc point nearest to the
     // crossing, CD (2,2) (docs/svrc-collars.md "Wiring status", item 5).
-    for (const RestrictedTriangle& t : restr.triangles) {
+    for (const RestrictedTriangle& t : restricted) {
       const PointId centre = collar_centre_[t.ball];
       const CollarBall& ball = collars_.ball(t.ball);
       for (uint32_t f : FacetsThrough(centre)) {

@@ -126,6 +126,15 @@ struct RefineOptions {
   // EnqueueMissing found in M_Ω. false: everything recomputed every round,
   // the reference the reuse must reproduce bit for bit (tests).
   bool reuse_round_work = true;
+  // When the COLLAR rounds run their facet-crossing check (a T′ edge
+  // crossing a facet through its ball's centre gets the facet's arc point
+  // nearest the crossing). true: in every round from the first one whose
+  // restricted triangulation needed no topology or circle repair. false: only
+  // in a round with no other repair (sessions 3–18), where each batch of arc
+  // points restarts the rounds: crease_pair 5° settled 7 times in 86 rounds;
+  // armadillo.off's first 5,845 arc points set off +2.5 M vertices
+  // (docs/svrc-collars.md "Session 19").
+  bool crossings_once_topology_holds = true;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
   // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
