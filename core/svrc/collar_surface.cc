@@ -32,23 +32,43 @@ uint64_t EdgeKey(uint32_t a, uint32_t b) {
 }
 
 // Sorts `items` by `less`, a total order whose first key is the vertex
-// `bucket(item)` < num_buckets: a counting sort by that vertex, then each
-// bucket by `less`. The same sequence as std::sort(less) (the items are
-// distinct under it) in linear time plus small sorts: the COLLAR rounds sort
-// every restricted triangle's entries, edges and link tuples each round, and
-// those std::sorts were ~7% of a fandisk.off run and ~12% of wedge-1.smesh's.
+// `bucket(item)` < num_buckets: a stable radix sort by that vertex (16 bits
+// per pass), then each run of one vertex by `less`. The same sequence as
+// std::sort(less) (the items are distinct under it) in linear time plus small
+// sorts: the COLLAR rounds sort every restricted triangle's entries, edges
+// and link tuples each round, and those std::sorts were ~7% of a fandisk.off
+// run and ~12% of wedge-1.smesh's. The counts are 2^16 entries whatever the
+// vertex count (a counting sort over every vertex id allocated and zeroed two
+// arrays of 23 M entries per call on armadillo.off: most of a tail round's
+// page zeroing, docs/svrc-collars.md "Session 19").
 template <class T, class Bucket, class Less>
 void SortByVertex(std::vector<T>* items, size_t num_buckets, Bucket bucket, Less less) {
-  std::vector<uint32_t> start(num_buckets + 1, 0);
-  for (const T& x : *items) ++start[bucket(x) + 1];
-  for (size_t b = 0; b < num_buckets; ++b) start[b + 1] += start[b];
-  std::vector<T> out(items->size());
-  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  for (const T& x : *items) out[fill[bucket(x)]++] = x;
-  for (size_t b = 0; b < num_buckets; ++b) {
-    if (start[b + 1] - start[b] > 1) std::sort(out.begin() + start[b], out.begin() + start[b + 1], less);
+  constexpr int kBits = 16;
+  constexpr size_t kRadix = size_t{1} << kBits;
+  std::vector<T> tmp(items->size());
+  std::vector<uint32_t> count(kRadix);
+  const int passes = num_buckets <= kRadix ? 1 : 2;
+  for (int pass = 0; pass < passes; ++pass) {
+    const int shift = pass * kBits;
+    std::fill(count.begin(), count.end(), 0);
+    for (const T& x : *items) ++count[(bucket(x) >> shift) & (kRadix - 1)];
+    uint32_t sum = 0;
+    for (uint32_t& c : count) {
+      const uint32_t n = c;
+      c = sum;
+      sum += n;
+    }
+    for (const T& x : *items) tmp[count[(bucket(x) >> shift) & (kRadix - 1)]++] = x;
+    items->swap(tmp);
   }
-  *items = std::move(out);
+  std::vector<T>& out = *items;
+  for (size_t i = 0; i < out.size();) {
+    size_t j = i + 1;
+    const uint32_t b = bucket(out[i]);
+    while (j < out.size() && bucket(out[j]) == b) ++j;
+    if (j - i > 1) std::sort(out.begin() + i, out.begin() + j, less);
+    i = j;
+  }
 }
 
 // V(u) ⊂ B(u, R_u) (R_u = the farthest Voronoi corner; +∞ on the hull, which
@@ -411,6 +431,9 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   std::vector<CollarRestrictionCache::PerBall> per_ball;
   if (cache != nullptr) per_ball.resize(nb);
   r.center_vertex.assign(nb, VertexId());
+  // About as many restricted triangles as last round: reserved, not grown by
+  // doubling (each growth copies and touches fresh pages).
+  if (cache != nullptr && reuse) r.triangles.reserve(cache->last_triangles + cache->last_triangles / 8);
   // R_u, memoised in the cache by u's generation (its star, hence its
   // Voronoi cell, is the same while the generation is).
   auto out_radius = [&](VertexId u) -> double {
@@ -516,6 +539,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
     cache->balls.assign(balls.begin(), balls.end());
     cache->circle_balls = std::move(circle_balls);
     cache->per_ball = std::move(per_ball);
+    cache->last_triangles = r.triangles.size();
     cache->last.circle_arcs = r.circle_arcs;
     cache->last.circle_state = r.circle_state;
     cache->last.circle_edges = r.circle_edges;
@@ -597,6 +621,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
     uint32_t best = 0;  // entry with the largest RepBall
   };
   std::vector<Unique> uniq;
+  uniq.reserve(order.size());
   for (uint32_t i : order) {
     if (uniq.empty() || uniq.back().v != triple(i)) uniq.push_back(Unique{triple(i), 0, i});
     Unique& u = uniq.back();
@@ -619,6 +644,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
   }
   // (b) every Delaunay edge in 0 or 2 restricted triangles of S.
   std::vector<std::pair<uint64_t, uint32_t>> edge_tri;  // edge → unique index
+  edge_tri.reserve(3 * uniq.size());
   for (uint32_t k = 0; k < uniq.size(); ++k) {
     const auto& v = uniq[k].v;
     edge_tri.push_back({EdgeKey(v[0], v[1]), k});
@@ -696,6 +722,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
   // (c) every vertex's restricted link in S is one cycle.
   {
     std::vector<std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>> link;  // v, a, b, entry
+    link.reserve(3 * uniq.size());
     for (const Unique& u : uniq) {
       link.push_back({u.v[0], u.v[1], u.v[2], u.best});
       link.push_back({u.v[1], u.v[0], u.v[2], u.best});

@@ -132,6 +132,7 @@ struct CollarRestrictionCache {
   std::vector<std::pair<uint32_t, uint32_t>> circle_balls;
   std::vector<PerBall> per_ball;
   CollarRestriction last;  // its circle members are reused
+  size_t last_triangles = 0;  // last.triangles' count (that member is not kept)
   // Per vertex: R_v (Delaunay3::OutRadius) at the generation it was computed
   // at; the candidate search of a recomputed ball reads it for cells whose
   // stars did not change since (wedge-1.smesh: the star walks and
