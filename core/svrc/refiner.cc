@@ -2401,6 +2401,9 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
       }
     }
   }
+  // The restricted triangles (64 bytes each, every ball's) are not needed
+  // past the check: not held while the repairs go in.
+  std::vector<RestrictedTriangle>().swap(restricted);
   // Cancellation and deadlines inside a round, as Run() polls between
   // events: one COLLAR round can insert tens of thousands of points
   // (fandisk.off: 49,892 repairs in round 9; a 900 s deadline ended the job
