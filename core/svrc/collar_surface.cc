@@ -128,12 +128,15 @@ std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b
 // which therefore meet the ball). Same constructions as
 // RestrictedSphereTriangles; the angle uses each vertex snapped to this
 // sphere (Snap, §3.1.2).
-void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, const BallGrid& grid, uint32_t ball,
-                     std::span<const uint32_t> cand, const std::vector<uint8_t>& is_cand,
-                     double delta, std::vector<RestrictedTriangle>* out) {
+// The restricted triangles of sphere `ball` owned by candidate vi (its
+// smallest vertex): a function of vi's star (its tets, their circumcentres
+// and vertices), of which star vertices are candidates, and of the balls.
+void OwnedSphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, const BallGrid& grid,
+                          uint32_t ball, uint32_t vi, const std::vector<uint8_t>& is_cand, double delta,
+                          std::vector<TetId>* star_scratch, std::vector<RestrictedTriangle>* out) {
   const CollarBall& b = balls[ball];
-  std::vector<TetId> star;
-  for (uint32_t vi : cand) {
+  std::vector<TetId>& star = *star_scratch;
+  {
     const VertexId v(vi);
     dt.Star(v, &star);
     for (TetId t : star) {
@@ -192,6 +195,13 @@ void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, con
       }
     }
   }
+}
+
+void SphereTriangles(const Delaunay3& dt, std::span<const CollarBall> balls, const BallGrid& grid, uint32_t ball,
+                     std::span<const uint32_t> cand, const std::vector<uint8_t>& is_cand,
+                     double delta, std::vector<RestrictedTriangle>* out) {
+  std::vector<TetId> star;
+  for (uint32_t vi : cand) OwnedSphereTriangles(dt, balls, grid, ball, vi, is_cand, delta, &star, out);
 }
 
 double CircleParam(const Circle3& c, const Vec3& x) {
@@ -428,6 +438,9 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   std::vector<uint8_t> computed(nb, 1);
   std::vector<uint32_t> touched;
   std::vector<RestrictedTriangle> tris;
+  std::vector<uint32_t> dirty;  // stamp = ball + 1: an owner whose neighbour's candidacy changed
+  std::vector<VertexId> nbr;
+  std::vector<TetId> star_scratch;
   std::vector<CollarRestrictionCache::PerBall> per_ball;
   if (cache != nullptr) per_ball.resize(nb);
   r.center_vertex.assign(nb, VertexId());
@@ -480,7 +493,69 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
     r.candidates_per_ball[i] = static_cast<uint32_t>(cand[i].size());
     for (uint32_t v : cand[i]) is_cand[v] = 1;
     tris.clear();
-    SphereTriangles(dt, balls, grid, i, cand[i], is_cand, opt.delta, &tris);
+    if (cache == nullptr) {
+      SphereTriangles(dt, balls, grid, i, cand[i], is_cand, opt.delta, &tris);
+    } else {
+      // Per owner: the last computation's triangles of a candidate whose
+      // star is unchanged (same generation) and none of whose neighbours
+      // entered or left the candidates; the others computed. The neighbour
+      // test is a guard: with the owner's star unchanged its faces' Voronoi
+      // edges are too, and a neighbour whose cell such an edge meets S in
+      // stays a candidate unless the search stops reaching it (the unit
+      // test's rounds never hit that case; dropping the generation test
+      // fails it).
+      const CollarRestrictionCache::PerBall* old =
+          reuse && i < cache->per_ball.size() && cache->per_ball[i].tri_begin.size() == cache->per_ball[i].cand.size() + 1
+              ? &cache->per_ball[i]
+              : nullptr;
+      const uint32_t stamp = i + 1;
+      if (old != nullptr) {
+        if (dirty.size() < dt.NumVertices()) dirty.resize(dt.NumVertices(), 0);
+        // Candidates that entered or left (both lists ascending), and their
+        // neighbours: the owners whose faces they are in.
+        auto mark = [&](uint32_t w) {
+          dirty[w] = stamp;
+          dt.Neighbors(VertexId(w), &nbr);
+          for (VertexId u : nbr) dirty[u.value()] = stamp;
+        };
+        const std::vector<uint32_t>& a = old->cand;
+        const std::vector<uint32_t>& c = cand[i];
+        size_t x = 0, y = 0;
+        while (x < a.size() || y < c.size()) {
+          if (y == c.size() || (x < a.size() && a[x] < c[y])) {
+            mark(a[x++]);
+          } else if (x == a.size() || c[y] < a[x]) {
+            mark(c[y++]);
+          } else {
+            ++x;
+            ++y;
+          }
+        }
+      }
+      CollarRestrictionCache::PerBall& pb = per_ball[i];
+      pb.cand_gen.clear();
+      pb.tri_begin.clear();
+      pb.cand_gen.reserve(cand[i].size());
+      pb.tri_begin.reserve(cand[i].size() + 1);
+      size_t j = 0;  // in old->cand
+      for (uint32_t v : cand[i]) {
+        const uint32_t g = cache->generation(v);
+        pb.tri_begin.push_back(static_cast<uint32_t>(tris.size()));
+        pb.cand_gen.push_back(g);
+        if (old != nullptr) {
+          while (j < old->cand.size() && old->cand[j] < v) ++j;
+          if (j < old->cand.size() && old->cand[j] == v && old->cand_gen[j] == g && dirty[v] != stamp) {
+            tris.insert(tris.end(), old->triangles.begin() + old->tri_begin[j],
+                        old->triangles.begin() + old->tri_begin[j + 1]);
+            ++cache->owners_reused;
+            continue;
+          }
+        }
+        OwnedSphereTriangles(dt, balls, grid, i, v, is_cand, opt.delta, &star_scratch, &tris);
+        ++cache->owners_computed;
+      }
+      pb.tri_begin.push_back(static_cast<uint32_t>(tris.size()));
+    }
     for (uint32_t v : cand[i]) is_cand[v] = 0;
     r.triangles.insert(r.triangles.end(), tris.begin(), tris.end());
     if (cache != nullptr) {

@@ -117,6 +117,7 @@ struct CollarRestrictionCache {
   std::function<uint32_t(uint32_t)> generation;
   // Work done by the calls so far.
   uint64_t balls_computed = 0, balls_reused = 0;
+  uint64_t owners_computed = 0, owners_reused = 0;  // candidates of computed balls
   uint64_t circles_computed = 0, circles_reused = 0;
 
   // Filled by ComputeCollarRestriction.
@@ -124,6 +125,13 @@ struct CollarRestrictionCache {
     std::vector<uint32_t> cand;                       // ascending
     std::vector<std::pair<uint32_t, uint32_t>> read;  // (vertex, generation) read
     std::vector<RestrictedTriangle> triangles;
+    // Per candidate (parallel to cand): its generation when its triangles
+    // were computed, and where they start in `triangles` (one more entry:
+    // the end). A recomputed ball copies the triangles of a candidate whose
+    // star did not change and none of whose Delaunay neighbours entered or
+    // left the candidates (those are all the triangles read).
+    std::vector<uint32_t> cand_gen;
+    std::vector<uint32_t> tri_begin;
     delaunay::VertexId center_vertex;
   };
   bool valid = false;

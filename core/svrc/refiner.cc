@@ -3315,6 +3315,8 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.collar_rounds = collar_rounds_;
   st.collar_balls_computed = restriction_cache_.balls_computed;
   st.collar_balls_reused = restriction_cache_.balls_reused;
+  st.collar_owners_computed = restriction_cache_.owners_computed;
+  st.collar_owners_reused = restriction_cache_.owners_reused;
   st.collar_repairs = collar_repairs_;
   st.collar_repairs_by_reason = collar_repairs_by_reason_;
   st.arc_repairs = arc_repairs_;
@@ -3508,6 +3510,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   if (collars > 0) {
     out->Set("svrc.collar_balls_computed", static_cast<double>(collar_balls_computed));
     out->Set("svrc.collar_balls_reused", static_cast<double>(collar_balls_reused));
+    out->Set("svrc.collar_owners_computed", static_cast<double>(collar_owners_computed));
+    out->Set("svrc.collar_owners_reused", static_cast<double>(collar_owners_reused));
     out->Set("svrc.arc_facets_computed", static_cast<double>(arc_facets_computed));
     out->Set("svrc.arc_facets_settled", static_cast<double>(arc_facets_settled));
   }

@@ -258,6 +258,11 @@ struct RefineStats {
   uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)
   uint64_t collar_balls_computed = 0;  // Del(M)|_S of one partial sphere computed in a COLLAR round
   uint64_t collar_balls_reused = 0;    // ... taken from the last round (no cell it read changed)
+  // In the computed balls: candidates whose restricted triangles were
+  // computed, and those taken from the ball's last computation (star and
+  // neighbours' candidacy unchanged).
+  uint64_t collar_owners_computed = 0;
+  uint64_t collar_owners_reused = 0;
   uint64_t arc_facets_computed = 0;    // ArcRepairs of one facet in a COLLAR round
   uint64_t arc_facets_settled = 0;     // ... skipped: nothing to repair last round, no insertion since
   uint64_t collar_pairs = 0;       // collar balls whose spheres intersect (pairs)
