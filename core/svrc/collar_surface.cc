@@ -334,6 +334,10 @@ int Euler(const std::vector<std::array<uint32_t, 3>>& tris) {
   return static_cast<int>(vs.size()) - static_cast<int>(es.size()) + static_cast<int>(tris.size());
 }
 
+}  // namespace
+
+namespace detail {
+
 // One cycle through every vertex of the graph given by `edges` (pairs), with
 // at least `min_vertices` vertices and no repeated edge. What it tests is
 // weaker than its name: no repeated edge, as many distinct vertices as edges
@@ -410,6 +414,12 @@ bool IsOneCycle(const std::vector<std::pair<uint32_t, uint32_t>>& in, size_t min
   }
   return true;
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::IsOneCycle;
 
 // One simple path through every vertex of the graph (a vertex link next to a
 // circle): no repeated edge, two vertices of degree 1, the rest degree 2,

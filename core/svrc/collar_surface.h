@@ -206,4 +206,15 @@ std::vector<CollarRepair> CollarRepairs(const delaunay::Delaunay3& dt,
                                         CollarRestrictionCache* cache = nullptr,
                                         std::vector<RestrictedTriangle>* triangles = nullptr);
 
+namespace detail {
+// The link and circle test of CollarRepairs (exposed for its unit test): no
+// repeated edge, as many distinct vertices as edges and at least
+// `min_vertices` of them, connected. Weaker than "one cycle": a connected
+// lollipop (degrees 1, 3, 2, 2) passes (docs/svrc-collars.md "Session 20").
+// IsOneCycle works on stack arrays up to 48 edges; IsOneCycleGeneral is the
+// allocating version (the reference).
+bool IsOneCycle(const std::vector<std::pair<uint32_t, uint32_t>>& edges, size_t min_vertices);
+bool IsOneCycleGeneral(std::vector<std::pair<uint32_t, uint32_t>> edges, size_t min_vertices);
+}  // namespace detail
+
 }  // namespace svrc::refine

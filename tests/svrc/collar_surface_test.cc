@@ -584,3 +584,49 @@ TEST(CollarSurfaceTest, DISABLED_MeasureSigmaAndSizeCriterion) {
 
 }  // namespace
 }  // namespace svrc::refine
+
+namespace svrc::refine {
+namespace {
+
+// The link/circle test: what it accepts and rejects (including the lollipop
+// it accepts, docs/svrc-collars.md "Session 20"), and the stack-array version
+// against the allocating one on random small graphs and past 48 edges.
+TEST(CollarSurfaceTest, CycleTestAnswersAsTheReference) {
+  using E = std::vector<std::pair<uint32_t, uint32_t>>;
+  EXPECT_TRUE(detail::IsOneCycle(E{{7, 3}, {3, 9}, {9, 7}}, 3));
+  EXPECT_TRUE(detail::IsOneCycle(E{{1, 2}, {4, 1}, {3, 4}, {2, 3}}, 3));
+  EXPECT_FALSE(detail::IsOneCycle(E{{7, 3}, {3, 9}, {9, 7}}, 4));                       // too few vertices
+  EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {3, 4}}, 3));                       // a path
+  EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {3, 1}, {4, 5}, {5, 6}, {6, 4}}, 3));  // two cycles
+  EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 1}, {2, 3}, {3, 1}}, 3));               // a repeated edge
+  EXPECT_FALSE(detail::IsOneCycle(E{}, 0));
+  EXPECT_TRUE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {2, 4}, {3, 4}}, 3));                // lollipop: accepted
+  std::mt19937_64 rng(3);
+  int trues = 0;
+  for (int it = 0; it < 200000; ++it) {
+    const uint32_t nv = 1 + rng() % 9, ne = 1 + rng() % 10;
+    E e;
+    if (it % 3 == 0) {
+      for (uint32_t i = 0; i < nv; ++i) e.push_back({100 + i, 100 + (i + 1) % nv});
+      if (rng() % 2) e.push_back({100 + static_cast<uint32_t>(rng() % nv), 100 + static_cast<uint32_t>(rng() % nv)});
+      if (rng() % 2) e.erase(e.begin() + static_cast<long>(rng() % e.size()));
+    } else {
+      for (uint32_t i = 0; i < ne; ++i) e.push_back({static_cast<uint32_t>(rng() % nv), static_cast<uint32_t>(rng() % nv)});
+    }
+    std::shuffle(e.begin(), e.end(), rng);
+    const size_t mv = rng() % 5;
+    const bool ref = detail::IsOneCycleGeneral(e, mv);
+    ASSERT_EQ(detail::IsOneCycle(e, mv), ref) << "graph " << it;
+    trues += ref ? 1 : 0;
+  }
+  EXPECT_GT(trues, 20000);
+  // Past the arrays: a 60-gon, and a 60-gon with one chord.
+  E big;
+  for (uint32_t i = 0; i < 60; ++i) big.push_back({i, (i + 1) % 60});
+  EXPECT_TRUE(detail::IsOneCycle(big, 3));
+  big.push_back({0, 30});
+  EXPECT_FALSE(detail::IsOneCycle(big, 3));
+}
+
+}  // namespace
+}  // namespace svrc::refine
