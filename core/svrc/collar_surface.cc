@@ -494,7 +494,8 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   std::vector<uint8_t> computed(nb, 1);
   std::vector<uint32_t> touched;
   std::vector<RestrictedTriangle> tris;
-  std::vector<uint32_t> dirty;  // stamp = ball + 1: an owner whose neighbour's candidacy changed
+  std::vector<uint8_t> dirty;     // an owner one of whose neighbours entered or left the candidates
+  std::vector<uint32_t> dirtied;  // its set entries, cleared after each ball
   std::vector<VertexId> nbr;
   std::vector<TetId> star_scratch;
   std::vector<CollarRestrictionCache::PerBall> per_ball;
@@ -564,15 +565,20 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
           reuse && i < cache->per_ball.size() && cache->per_ball[i].tri_begin.size() == cache->per_ball[i].cand.size() + 1
               ? &cache->per_ball[i]
               : nullptr;
-      const uint32_t stamp = i + 1;
       if (old != nullptr) {
         if (dirty.size() < dt.NumVertices()) dirty.resize(dt.NumVertices(), 0);
         // Candidates that entered or left (both lists ascending), and their
         // neighbours: the owners whose faces they are in.
+        auto set = [&](uint32_t u) {
+          if (!dirty[u]) {
+            dirty[u] = 1;
+            dirtied.push_back(u);
+          }
+        };
         auto mark = [&](uint32_t w) {
-          dirty[w] = stamp;
+          set(w);
           dt.Neighbors(VertexId(w), &nbr);
-          for (VertexId u : nbr) dirty[u.value()] = stamp;
+          for (VertexId u : nbr) set(u.value());
         };
         const std::vector<uint32_t>& a = old->cand;
         const std::vector<uint32_t>& c = cand[i];
@@ -600,7 +606,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
         pb.cand_gen.push_back(g);
         if (old != nullptr) {
           while (j < old->cand.size() && old->cand[j] < v) ++j;
-          if (j < old->cand.size() && old->cand[j] == v && old->cand_gen[j] == g && dirty[v] != stamp) {
+          if (j < old->cand.size() && old->cand[j] == v && old->cand_gen[j] == g && !dirty[v]) {
             tris.insert(tris.end(), old->triangles.begin() + old->tri_begin[j],
                         old->triangles.begin() + old->tri_begin[j + 1]);
             ++cache->owners_reused;
@@ -611,6 +617,8 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
         ++cache->owners_computed;
       }
       pb.tri_begin.push_back(static_cast<uint32_t>(tris.size()));
+      for (uint32_t u : dirtied) dirty[u] = 0;
+      dirtied.clear();
     }
     for (uint32_t v : cand[i]) is_cand[v] = 0;
     r.triangles.insert(r.triangles.end(), tris.begin(), tris.end());
