@@ -140,6 +140,11 @@ struct CollarRestrictionCache {
   std::vector<std::pair<uint32_t, uint32_t>> circle_balls;
   std::vector<PerBall> per_ball;
   CollarRestriction last;  // its circle members are reused
+  // Per circle: the candidates of both its balls at its last computation
+  // and their generations then (an edge's owner with the same generation,
+  // none of whose neighbours entered or left the list, keeps its edges).
+  std::vector<std::vector<uint32_t>> circle_both, circle_both_gen;
+  uint64_t circle_owners_computed = 0, circle_owners_reused = 0;
   size_t last_triangles = 0;  // last.triangles' count (that member is not kept)
   // Per vertex: R_v (Delaunay3::OutRadius) at the generation it was computed
   // at; the candidate search of a recomputed ball reads it for cells whose

@@ -3317,6 +3317,8 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.collar_balls_reused = restriction_cache_.balls_reused;
   st.collar_owners_computed = restriction_cache_.owners_computed;
   st.collar_owners_reused = restriction_cache_.owners_reused;
+  st.collar_circle_owners_computed = restriction_cache_.circle_owners_computed;
+  st.collar_circle_owners_reused = restriction_cache_.circle_owners_reused;
   st.collar_repairs = collar_repairs_;
   st.collar_repairs_by_reason = collar_repairs_by_reason_;
   st.arc_repairs = arc_repairs_;
@@ -3512,6 +3514,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
     out->Set("svrc.collar_balls_reused", static_cast<double>(collar_balls_reused));
     out->Set("svrc.collar_owners_computed", static_cast<double>(collar_owners_computed));
     out->Set("svrc.collar_owners_reused", static_cast<double>(collar_owners_reused));
+    out->Set("svrc.collar_circle_owners_computed", static_cast<double>(collar_circle_owners_computed));
+    out->Set("svrc.collar_circle_owners_reused", static_cast<double>(collar_circle_owners_reused));
     out->Set("svrc.arc_facets_computed", static_cast<double>(arc_facets_computed));
     out->Set("svrc.arc_facets_settled", static_cast<double>(arc_facets_settled));
   }

@@ -263,6 +263,8 @@ struct RefineStats {
   // neighbours' candidacy unchanged).
   uint64_t collar_owners_computed = 0;
   uint64_t collar_owners_reused = 0;
+  uint64_t collar_circle_owners_computed = 0;  // the same for the circles' restricted edges
+  uint64_t collar_circle_owners_reused = 0;
   uint64_t arc_facets_computed = 0;    // ArcRepairs of one facet in a COLLAR round
   uint64_t arc_facets_settled = 0;     // ... skipped: nothing to repair last round, no insertion since
   uint64_t collar_pairs = 0;       // collar balls whose spheres intersect (pairs)

@@ -469,6 +469,7 @@ struct CacheRun {
   int rounds = 0, mismatches = 0;
   uint64_t computed = 0, reused = 0;
   uint64_t owners_computed = 0, owners_reused = 0;
+  uint64_t circle_owners_computed = 0, circle_owners_reused = 0;
   std::string first_why;
 };
 
@@ -512,6 +513,8 @@ CacheRun DriveWithCache(const Scene& s, bool track_generations, size_t per_round
   run.computed = cache.balls_computed;
   run.owners_computed = cache.owners_computed;
   run.owners_reused = cache.owners_reused;
+  run.circle_owners_computed = cache.circle_owners_computed;
+  run.circle_owners_reused = cache.circle_owners_reused;
   run.reused = cache.balls_reused - static_cast<uint64_t>(run.rounds) * s.balls.size();
   return run;
 }
@@ -546,10 +549,14 @@ TEST(CollarSurfaceTest, CachedRestrictionEqualsFreshRoundByRound) {
     // computation (a repair changes a few stars), and the result is still
     // the fresh one (mismatches above).
     EXPECT_GT(run.owners_reused, run.owners_computed) << s.name;
-    std::printf("%s: %d rounds, balls computed %llu, reused %llu; owners computed %llu, reused %llu\n", s.name.c_str(),
-                run.rounds, static_cast<unsigned long long>(run.computed), static_cast<unsigned long long>(run.reused),
-                static_cast<unsigned long long>(run.owners_computed),
-                static_cast<unsigned long long>(run.owners_reused));
+    EXPECT_GT(run.circle_owners_reused, run.circle_owners_computed) << s.name;
+    std::printf("%s: %d rounds, balls computed %llu, reused %llu; owners computed %llu, reused %llu; circle owners "
+                "computed %llu, reused %llu\n",
+                s.name.c_str(), run.rounds, static_cast<unsigned long long>(run.computed),
+                static_cast<unsigned long long>(run.reused), static_cast<unsigned long long>(run.owners_computed),
+                static_cast<unsigned long long>(run.owners_reused),
+                static_cast<unsigned long long>(run.circle_owners_computed),
+                static_cast<unsigned long long>(run.circle_owners_reused));
   }
   const CacheRun broken = DriveWithCache(WithBackground(LongChain(), 0.3, 3, 4), /*track_generations=*/false, 1, 10);
   EXPECT_GT(broken.mismatches, 0) << "a cache that never sees a cell change must return stale triangles";
