@@ -115,7 +115,11 @@ std::vector<uint32_t> CandidateVertices(const Delaunay3& dt, const CollarBall& b
       if ((*seen)[u.value()]) continue;
       (*seen)[u.value()] = 1;
       touched.push_back(u.value());
-      if (CellMayMeetBall(dt, u, out_radius(u), b)) queue.push_back(u.value());
+      // A vertex in the closed ball passes the test whatever R_u is (and
+      // R_u may cost a star walk): the same answer without it.
+      if (geom::Dist(dt.Point(u), b.center) <= b.radius || CellMayMeetBall(dt, u, out_radius(u), b)) {
+        queue.push_back(u.value());
+      }
     }
   }
   for (uint32_t v : touched) (*seen)[v] = 0;
