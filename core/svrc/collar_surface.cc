@@ -79,6 +79,41 @@ bool CellMayMeetBall(const Delaunay3& dt, VertexId u, double r, const CollarBall
   return geom::Dist(dt.Point(u), b.center) - r <= b.radius * (1 + 1e-9) + 1e-9 * r;
 }
 
+// The owners a reused ball or circle must compute again because their
+// neighbourhood's membership changed: the vertices that entered or left its
+// member list (candidates, or `both` for a circle) since its last
+// computation, and their Delaunay neighbours (the owners of the faces and
+// edges they are in). A byte per vertex, cleared after each list.
+class ChangedOwners {
+ public:
+  void Mark(const Delaunay3& dt, const std::vector<uint32_t>& before, const std::vector<uint32_t>& now) {
+    if (dirty_.size() < dt.NumVertices()) dirty_.resize(dt.NumVertices(), 0);
+    changed_.clear();
+    std::set_symmetric_difference(before.begin(), before.end(), now.begin(), now.end(), std::back_inserter(changed_));
+    for (uint32_t w : changed_) {
+      Set(w);
+      dt.Neighbors(VertexId(w), &nbr_);
+      for (VertexId u : nbr_) Set(u.value());
+    }
+  }
+  bool Has(uint32_t v) const { return v < dirty_.size() && dirty_[v] != 0; }
+  void Clear() {
+    for (uint32_t u : set_) dirty_[u] = 0;
+    set_.clear();
+  }
+
+ private:
+  void Set(uint32_t u) {
+    if (!dirty_[u]) {
+      dirty_[u] = 1;
+      set_.push_back(u);
+    }
+  }
+  std::vector<uint8_t> dirty_;
+  std::vector<uint32_t> set_, changed_;
+  std::vector<VertexId> nbr_;
+};
+
 // Vertices whose Voronoi cell may meet ball b, ascending. The cells that do
 // meet the ball cover it, and the ball is connected, so they form a connected
 // set of Voronoi neighbours containing the cell of the centre: a walk from
@@ -511,9 +546,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
   std::vector<uint8_t> computed(nb, 1);
   std::vector<uint32_t> touched;
   std::vector<RestrictedTriangle> tris;
-  std::vector<uint8_t> dirty;     // an owner one of whose neighbours entered or left the candidates
-  std::vector<uint32_t> dirtied;  // its set entries, cleared after each ball
-  std::vector<VertexId> nbr;
+  ChangedOwners changed;
   std::vector<TetId> star_scratch;
   std::vector<CollarRestrictionCache::PerBall> per_ball;
   if (cache != nullptr) per_ball.resize(nb);
@@ -582,35 +615,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
           reuse && i < cache->per_ball.size() && cache->per_ball[i].tri_begin.size() == cache->per_ball[i].cand.size() + 1
               ? &cache->per_ball[i]
               : nullptr;
-      if (old != nullptr) {
-        if (dirty.size() < dt.NumVertices()) dirty.resize(dt.NumVertices(), 0);
-        // Candidates that entered or left (both lists ascending), and their
-        // neighbours: the owners whose faces they are in.
-        auto set = [&](uint32_t u) {
-          if (!dirty[u]) {
-            dirty[u] = 1;
-            dirtied.push_back(u);
-          }
-        };
-        auto mark = [&](uint32_t w) {
-          set(w);
-          dt.Neighbors(VertexId(w), &nbr);
-          for (VertexId u : nbr) set(u.value());
-        };
-        const std::vector<uint32_t>& a = old->cand;
-        const std::vector<uint32_t>& c = cand[i];
-        size_t x = 0, y = 0;
-        while (x < a.size() || y < c.size()) {
-          if (y == c.size() || (x < a.size() && a[x] < c[y])) {
-            mark(a[x++]);
-          } else if (x == a.size() || c[y] < a[x]) {
-            mark(c[y++]);
-          } else {
-            ++x;
-            ++y;
-          }
-        }
-      }
+      if (old != nullptr) changed.Mark(dt, old->cand, cand[i]);
       CollarRestrictionCache::PerBall& pb = per_ball[i];
       pb.cand_gen.clear();
       pb.tri_begin.clear();
@@ -623,7 +628,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
         pb.cand_gen.push_back(g);
         if (old != nullptr) {
           while (j < old->cand.size() && old->cand[j] < v) ++j;
-          if (j < old->cand.size() && old->cand[j] == v && old->cand_gen[j] == g && !dirty[v]) {
+          if (j < old->cand.size() && old->cand[j] == v && old->cand_gen[j] == g && !changed.Has(v)) {
             tris.insert(tris.end(), old->triangles.begin() + old->tri_begin[j],
                         old->triangles.begin() + old->tri_begin[j + 1]);
             ++cache->owners_reused;
@@ -634,8 +639,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
         ++cache->owners_computed;
       }
       pb.tri_begin.push_back(static_cast<uint32_t>(tris.size()));
-      for (uint32_t u : dirtied) dirty[u] = 0;
-      dirtied.clear();
+      changed.Clear();
     }
     for (uint32_t v : cand[i]) is_cand[v] = 0;
     r.triangles.insert(r.triangles.end(), tris.begin(), tris.end());
@@ -690,32 +694,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
                             cache->circle_both_gen[k].size() == cache->circle_both[k].size();
       const std::vector<uint32_t>* old_both = have_old ? &cache->circle_both[k] : nullptr;
       const std::vector<RestrictedEdge>* old_edges = have_old ? &cache->last.circle_edges[k] : nullptr;
-      if (have_old) {
-        if (dirty.size() < dt.NumVertices()) dirty.resize(dt.NumVertices(), 0);
-        auto set = [&](uint32_t q) {
-          if (!dirty[q]) {
-            dirty[q] = 1;
-            dirtied.push_back(q);
-          }
-        };
-        auto mark = [&](uint32_t q) {
-          set(q);
-          dt.Neighbors(VertexId(q), &nbr);
-          for (VertexId x : nbr) set(x.value());
-        };
-        const std::vector<uint32_t>& a = *old_both;
-        size_t x = 0, y = 0;
-        while (x < a.size() || y < both.size()) {
-          if (y == both.size() || (x < a.size() && a[x] < both[y])) {
-            mark(a[x++]);
-          } else if (x == a.size() || both[y] < a[x]) {
-            mark(both[y++]);
-          } else {
-            ++x;
-            ++y;
-          }
-        }
-      }
+      if (have_old) changed.Mark(dt, *old_both, both);
       Vec3 fu, fw;
       CircleFrame(cc.circle, &fu, &fw);
       std::vector<VertexId> cnb, cnbb;
@@ -728,7 +707,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
         gens.push_back(g);
         if (have_old) {
           while (j < old_both->size() && (*old_both)[j] < ia) ++j;
-          if (j < old_both->size() && (*old_both)[j] == ia && cache->circle_both_gen[k][j] == g && !dirty[ia]) {
+          if (j < old_both->size() && (*old_both)[j] == ia && cache->circle_both_gen[k][j] == g && !changed.Has(ia)) {
             auto lo = std::lower_bound(old_edges->begin(), old_edges->end(), ia,
                                        [](const RestrictedEdge& e, uint32_t v) { return e.v[0].value() < v; });
             for (; lo != old_edges->end() && lo->v[0].value() == ia; ++lo) edges.push_back(*lo);
@@ -739,8 +718,7 @@ CollarRestriction ComputeCollarRestriction(const Delaunay3& dt, const CollarDesc
         OwnedCircleEdges(dt, cc, grid, both, opt.delta, ia, fu, fw, &cnb, &cnbb, &cnbb_of, &edges);
         ++cache->circle_owners_computed;
       }
-      for (uint32_t q : dirtied) dirty[q] = 0;
-      dirtied.clear();
+      changed.Clear();
       circle_both[k] = both;
     }
     std::vector<double> params(edges.size());
