@@ -212,14 +212,16 @@ std::vector<CollarRepair> CollarRepairs(const delaunay::Delaunay3& dt,
                                         std::vector<RestrictedTriangle>* triangles = nullptr);
 
 namespace detail {
-// The link and circle test of CollarRepairs (exposed for its unit test): no
-// repeated edge, as many distinct vertices as edges and at least
-// `min_vertices` of them, connected. Weaker than "one cycle": a connected
-// lollipop (degrees 1, 3, 2, 2) passes (docs/svrc-collars.md "Session 20").
+// The link and circle test of CollarRepairs (exposed for its unit test): one
+// cycle through every vertex: no repeated edge, every vertex of degree 2, at
+// least `min_vertices` vertices, connected. With exact_degrees false the
+// degree test is an average (E = V: connected with one cycle, so a lollipop
+// with degrees 1, 3, 2, 2 passes), which the vertex links use since test (b)
+// covers the rest (docs/svrc-collars.md "Session 21").
 // IsOneCycle works on stack arrays up to 48 edges; IsOneCycleGeneral is the
 // allocating version (the reference).
-bool IsOneCycle(const std::vector<std::pair<uint32_t, uint32_t>>& edges, size_t min_vertices);
-bool IsOneCycleGeneral(std::vector<std::pair<uint32_t, uint32_t>> edges, size_t min_vertices);
+bool IsOneCycle(const std::vector<std::pair<uint32_t, uint32_t>>& edges, size_t min_vertices, bool exact_degrees);
+bool IsOneCycleGeneral(std::vector<std::pair<uint32_t, uint32_t>> edges, size_t min_vertices, bool exact_degrees);
 }  // namespace detail
 
 }  // namespace svrc::refine

@@ -13,8 +13,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numbers>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -595,21 +597,59 @@ TEST(CollarSurfaceTest, DISABLED_MeasureSigmaAndSizeCriterion) {
 namespace svrc::refine {
 namespace {
 
-// The link/circle test: what it accepts and rejects (including the lollipop
-// it accepts, docs/svrc-collars.md "Session 20"), and the stack-array version
-// against the allocating one on random small graphs and past 48 edges.
+// The definition, written plainly: no repeated edge (either direction), every
+// vertex of degree 2 (a loop counts 2) or, with exact_degrees false, as many
+// vertices as edges; connected by a search; ≥ min vertices.
+bool OneCycleByDegrees(const std::vector<std::pair<uint32_t, uint32_t>>& e, size_t min_vertices, bool exact_degrees) {
+  if (e.empty()) return false;
+  std::set<std::pair<uint32_t, uint32_t>> seen;
+  std::map<uint32_t, std::vector<uint32_t>> adj;
+  for (auto [a, b] : e) {
+    if (!seen.insert(std::minmax(a, b)).second) return false;
+    adj[a].push_back(b);
+    adj[b].push_back(a);
+  }
+  for (const auto& [v, n] : adj) {
+    if (exact_degrees && n.size() != 2) return false;
+  }
+  if (adj.size() != e.size()) return false;
+  std::set<uint32_t> reached{adj.begin()->first};
+  std::vector<uint32_t> stack{adj.begin()->first};
+  while (!stack.empty()) {
+    const uint32_t v = stack.back();
+    stack.pop_back();
+    for (uint32_t w : adj[v]) {
+      if (reached.insert(w).second) stack.push_back(w);
+    }
+  }
+  return reached.size() == adj.size() && adj.size() >= min_vertices;
+}
+
+// The link/circle test: what it accepts and rejects, exact and by average
+// degree (the lollipop: accepted by every caller until session 21), the
+// stack-array version against the allocating one and both against the
+// definition on random small graphs, and past 48 edges.
 TEST(CollarSurfaceTest, CycleTestAnswersAsTheReference) {
   using E = std::vector<std::pair<uint32_t, uint32_t>>;
-  EXPECT_TRUE(detail::IsOneCycle(E{{7, 3}, {3, 9}, {9, 7}}, 3));
-  EXPECT_TRUE(detail::IsOneCycle(E{{1, 2}, {4, 1}, {3, 4}, {2, 3}}, 3));
-  EXPECT_FALSE(detail::IsOneCycle(E{{7, 3}, {3, 9}, {9, 7}}, 4));                       // too few vertices
-  EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {3, 4}}, 3));                       // a path
-  EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {3, 1}, {4, 5}, {5, 6}, {6, 4}}, 3));  // two cycles
-  EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 1}, {2, 3}, {3, 1}}, 3));               // a repeated edge
-  EXPECT_FALSE(detail::IsOneCycle(E{}, 0));
-  EXPECT_TRUE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {2, 4}, {3, 4}}, 3));                // lollipop: accepted
+  for (bool exact : {true, false}) {
+    EXPECT_TRUE(detail::IsOneCycle(E{{7, 3}, {3, 9}, {9, 7}}, 3, exact));
+    EXPECT_TRUE(detail::IsOneCycle(E{{1, 2}, {4, 1}, {3, 4}, {2, 3}}, 3, exact));
+    EXPECT_FALSE(detail::IsOneCycle(E{{7, 3}, {3, 9}, {9, 7}}, 4, exact));                       // too few vertices
+    EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {3, 4}}, 3, exact));                       // a path
+    EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 3}, {3, 1}, {4, 5}, {5, 6}, {6, 4}}, 3, exact));  // two cycles
+    EXPECT_FALSE(detail::IsOneCycle(E{{1, 2}, {2, 1}, {2, 3}, {3, 1}}, 3, exact));               // a repeated edge
+    EXPECT_FALSE(detail::IsOneCycle(E{}, 0, exact));
+  }
+  // Degrees 1, 3, 2, 2 (a lollipop) and 1, 3, 2, 3, 1 (a triangle with two
+  // tails): connected, as many vertices as edges.
+  for (const E& e : {E{{1, 2}, {2, 3}, {2, 4}, {3, 4}}, E{{1, 2}, {2, 3}, {3, 4}, {4, 2}, {4, 5}}}) {
+    EXPECT_FALSE(detail::IsOneCycle(e, 3, true));
+    EXPECT_FALSE(detail::IsOneCycleGeneral(e, 3, true));
+    EXPECT_TRUE(detail::IsOneCycle(e, 3, false));
+    EXPECT_TRUE(detail::IsOneCycleGeneral(e, 3, false));
+  }
   std::mt19937_64 rng(3);
-  int trues = 0;
+  int trues[2] = {0, 0};
   for (int it = 0; it < 200000; ++it) {
     const uint32_t nv = 1 + rng() % 9, ne = 1 + rng() % 10;
     E e;
@@ -622,17 +662,24 @@ TEST(CollarSurfaceTest, CycleTestAnswersAsTheReference) {
     }
     std::shuffle(e.begin(), e.end(), rng);
     const size_t mv = rng() % 5;
-    const bool ref = detail::IsOneCycleGeneral(e, mv);
-    ASSERT_EQ(detail::IsOneCycle(e, mv), ref) << "graph " << it;
-    trues += ref ? 1 : 0;
+    for (bool exact : {true, false}) {
+      const bool ref = detail::IsOneCycleGeneral(e, mv, exact);
+      ASSERT_EQ(detail::IsOneCycle(e, mv, exact), ref) << "graph " << it << " exact " << exact;
+      ASSERT_EQ(ref, OneCycleByDegrees(e, mv, exact)) << "graph " << it << " exact " << exact;
+      trues[exact ? 1 : 0] += ref ? 1 : 0;
+    }
   }
-  EXPECT_GT(trues, 20000);
+  EXPECT_GT(trues[1], 15000);
+  EXPECT_GT(trues[0], trues[1]);  // the average test accepts graphs the exact one does not
   // Past the arrays: a 60-gon, and a 60-gon with one chord.
   E big;
   for (uint32_t i = 0; i < 60; ++i) big.push_back({i, (i + 1) % 60});
-  EXPECT_TRUE(detail::IsOneCycle(big, 3));
+  EXPECT_TRUE(detail::IsOneCycle(big, 3, true));
   big.push_back({0, 30});
-  EXPECT_FALSE(detail::IsOneCycle(big, 3));
+  EXPECT_FALSE(detail::IsOneCycle(big, 3, true));
+  big.back() = {0, 100};  // a 60-gon with a tail: 61 vertices, 61 edges
+  EXPECT_FALSE(detail::IsOneCycle(big, 3, true));
+  EXPECT_TRUE(detail::IsOneCycle(big, 3, false));
 }
 
 }  // namespace
