@@ -957,13 +957,12 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
         ring.push_back({std::get<1>(link[j]), std::get<2>(link[j])});
         entries.push_back(std::get<3>(link[j]));
       }
-      // The average-degree test: a vertex link with a vertex x of degree
-      // other than 2 has its edge (v, x) in 1 or 3 restricted triangles,
-      // which (b) reports and repairs already (with a second repair here, at
-      // the far end of v's restricted cell, crease_pair 10° went 44,576 →
-      // 53,466 tets and schonhardt.off ended FAILED_PRECONDITION;
-      // docs/svrc-collars.md "Session 21").
-      if (!IsOneCycle(ring, 3, /*exact_degrees=*/false)) {
+      // By default the average-degree test: a vertex link with a vertex x of
+      // degree other than 2 has its edge (v, x) in 1 or 3 restricted
+      // triangles, which (b) reports and repairs already (with a second
+      // repair here, at the far end of v's restricted cell, crease_pair 10°
+      // went 44,576 → 53,466 tets; docs/svrc-collars.md "Session 21").
+      if (!IsOneCycle(ring, 3, opt.exact_vertex_links)) {
         ++rep.bad_links;
         repair_link(v, entries, kAll);
       }

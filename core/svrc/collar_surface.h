@@ -61,6 +61,11 @@ struct CollarSurfaceOptions {
   // repairs do not read them; the refiner turns it off (their sorts were ~3%
   // of wedge-1.smesh's COLLAR rounds).
   bool topology_summary = true;
+  // Test (c), each vertex's link one cycle: exact (every link vertex of
+  // degree 2) or, false, by average degree, the degree part left to (b),
+  // which reports an edge in 1 or 3 restricted triangles. The exact test
+  // repairs the same defect twice (docs/svrc-collars.md "Session 21").
+  bool exact_vertex_links = false;
 };
 
 // One COLLAR event (Definition 38's RepBall B(x, radius) to destroy): insert x.

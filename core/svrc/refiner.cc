@@ -620,6 +620,7 @@ class Refiner {
   // Arc points for stitched tets crossing a facet inside a collar, beyond the
   // chords of T′ (RepairStitchedCrossings).
   uint32_t stitched_arc_crossings_ = 0;
+  uint32_t stitched_crossings_ = 0;  // all points for stitched tets crossing a facet
  private:
   RefineStats stats_;
   uint64_t budget_ = 0;
@@ -2318,6 +2319,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   copt.topology_summary = false;  // χ and components: diagnostics the rounds do not read
   copt.sigma = options_.max_rep_angle;
   copt.delta = collar_snap_;
+  copt.exact_vertex_links = options_.collar_exact_vertex_links;
   copt.size_criterion = options_.collar_size_eps > 0;
   if (copt.size_criterion) copt.eps_s = options_.collar_size_eps;
   surface_report_ = CollarSurfaceReport();
@@ -2607,8 +2609,14 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
       const plc::FacetFrame& fr = frames_[f];
       for (int a = 0; a < 4; ++a) {
         for (int b = a + 1; b < 4; ++b) {
-          const Vec3& pa = points_.Xyz(PointId(t[a]));
-          const Vec3& pb = points_.Xyz(PointId(t[b]));
+          // The edge in one orientation (smaller id first): its tets list it
+          // in either, and the two crossings differ in the last bits, so they
+          // were two hits, the second inserted ~1e-17 from the first
+          // (schonhardt.off with exact vertex-link tests, session 21: M_F then
+          // refined to the resolution of doubles).
+          const uint32_t ia = std::min(t[a], t[b]), ib = std::max(t[a], t[b]);
+          const Vec3& pa = points_.Xyz(PointId(ia));
+          const Vec3& pb = points_.Xyz(PointId(ib));
           Vec3 x;
           if (!CrossesPlane(fr, pa, pb, 1e-12 * collars_.ball(bi).radius, &x)) continue;
           Vec2 uv = fr.ToPlane(x);
@@ -2651,6 +2659,7 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
     absl::Status st = DestroyFacet(f, c, d, hint, TriId2(), on_arc ? Cd{2, 2} : kCdFacet, /*jitter=*/false);
     if (!st.ok()) return st;
     ++inserted;
+    ++stitched_crossings_;
     if (on_arc) ++stitched_arc_crossings_;
   }
   if (inserted > 0) ClearStitch();
@@ -3323,6 +3332,7 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.collar_repairs_by_reason = collar_repairs_by_reason_;
   st.arc_repairs = arc_repairs_;
   st.stitched_arc_crossings = stitched_arc_crossings_;
+  st.stitched_crossings = stitched_crossings_;
   st.steiner_vertices = st.vertices - 8 - st.input_vertices - segment_in_omega - st.facet_vertices_in_omega;
   const WorkQueues::Stats& q = queues_.stats();
   for (int i = 0; i < kNumEventTypes; ++i) {
@@ -3528,6 +3538,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   }
   out->Set("svrc.arc_repairs", static_cast<double>(arc_repairs));
   if (collars > 0) out->Set("svrc.stitched_arc_crossings", static_cast<double>(stitched_arc_crossings));
+  if (collars > 0) out->Set("svrc.stitched_crossings", static_cast<double>(stitched_crossings));
   out->Set("svrc.collar_pairs", static_cast<double>(collar_pairs));
   out->Set("svrc.collar_pairs_not_smooth", static_cast<double>(collar_pairs_not_smooth));
   out->Set("svrc.collar_worst_smoothness", collar_worst_smoothness);

@@ -135,6 +135,10 @@ struct RefineOptions {
   // armadillo.off's first 5,845 arc points set off +2.5 M vertices
   // (docs/svrc-collars.md "Session 19").
   bool crossings_once_topology_holds = true;
+  // CollarSurfaceOptions::exact_vertex_links (test (c) exact; false: by
+  // average degree, (b) covering the rest). Measured in docs/svrc-collars.md
+  // "Session 21": more rounds on 5 of 11 crease inputs.
+  bool collar_exact_vertex_links = false;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
   // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
@@ -281,6 +285,7 @@ struct RefineStats {
   std::array<uint64_t, 4> collar_repairs_by_reason{};
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar
+  uint64_t stitched_crossings = 0;      // all points for stitched tets crossing a facet (arc points included)
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   uint64_t slivers_broken = 0;     // kept slivers broken by an insertion at the end (per-tet mode)
   std::array<uint64_t, 4> events_pushed{};   // by EventType

@@ -981,5 +981,38 @@ TEST(CollarRefine, CrossingsCheckedOnceTopologyHoldsSettleInFewerRounds) {
               (unsigned long long)stats[1].collar_rounds, (unsigned long long)stats[1].vertices);
 }
 
+// RepairStitchedCrossings listed a crossing once per tet of the crossing edge,
+// computed from the edge in that tet's orientation; the two orientations
+// differ in the last bits, so one crossing became two hits, the second
+// inserted 6.9e-18 from the first and M_F refined to the resolution of
+// doubles (FAILED_PRECONDITION). Reached on schonhardt.off with the exact
+// vertex-link test (docs/svrc-collars.md "Session 21"); this run must mesh,
+// conform, and go through the stitched-crossing repair (if a change elsewhere
+// stops it from reaching that repair, this input no longer tests it).
+TEST(CollarRefine, StitchedCrossingsAreOnePointPerEdge) {
+  if (kSanitized) GTEST_SKIP() << "release only (seconds per run)";
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/schonhardt.off"));
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+  ASSERT_TRUE(cx.ok()) << cx.status();
+  RefineOptions opt;
+  opt.tau = 4;
+  opt.collars = true;
+  opt.collar_surface = true;
+  opt.max_rep_angle = 60 * M_PI / 180;
+  opt.collar_exact_vertex_links = true;
+  absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+  ASSERT_TRUE(run.ok()) << run.status();
+  EXPECT_GT(run->stats.stitched_crossings, 0u);
+  const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
+  absl::StatusOr<OutputStageResult> out = BuildOutputMesh(*plc, run->normalised_positions, run->tets,
+                                                          cx->point_of_vertex, faces, CoordinateMapOf(*run), false);
+  ASSERT_TRUE(out.ok()) << out.status();
+  const mesh::ConformityReport rep = mesh::CheckConformity(*plc, out->mesh);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  std::printf("schonhardt.off, exact vertex links: %llu stitched crossings, %zu tets\n",
+              (unsigned long long)run->stats.stitched_crossings, run->tets.size());
+}
+
 }  // namespace
 }  // namespace svrc::refine
