@@ -1089,7 +1089,7 @@ std::vector<CollarRepair> CollarRepairs(const Delaunay3& dt, const CollarDescrip
       }
       const bool ok = std::binary_search(on_circle.begin(), on_circle.end(), v)
                           ? IsOnePath(ring)
-                          : IsOneCycle(ring, 3, /*exact_degrees=*/true);
+                          : IsOneCycle(ring, 3, opt.exact_sphere_links);
       if (!ok) {
         ++rep.bad_sphere_links;
         repair_link(v, entries, bi);

@@ -2320,6 +2320,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   copt.sigma = options_.max_rep_angle;
   copt.delta = collar_snap_;
   copt.exact_vertex_links = options_.collar_exact_vertex_links;
+  copt.exact_sphere_links = options_.collar_exact_sphere_links;
   copt.size_criterion = options_.collar_size_eps > 0;
   if (copt.size_criterion) copt.eps_s = options_.collar_size_eps;
   surface_report_ = CollarSurfaceReport();

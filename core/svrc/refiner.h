@@ -139,6 +139,10 @@ struct RefineOptions {
   // average degree, (b) covering the rest). Measured in docs/svrc-collars.md
   // "Session 21": more rounds on 5 of 11 crease inputs.
   bool collar_exact_vertex_links = false;
+  // CollarSurfaceOptions::exact_sphere_links (tests (d)/(f) exact). Off:
+  // with it fandisk.off's stitched mesh leaked (docs/svrc-collars.md
+  // "Session 21").
+  bool collar_exact_sphere_links = false;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
   // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
