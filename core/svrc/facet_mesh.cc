@@ -220,23 +220,37 @@ bool FacetMesh::InFacet(TriId2 t) const {
   // Two vertices on s: its side is its line, no crossing. One vertex on s:
   // crossing iff the other two are strictly on opposite sides.
   for (size_t k = 0; k < region_.segments.size(); ++k) {
-    const Vec2 s0 = region_.segments[k][0], s1 = region_.segments[k][1];
-    int on = 0;
-    std::array<int, 3> off{};
-    int n_off = 0;
-    for (int i = 0; i < 3; ++i) {
-      if (OnSegment(dt_.TriVertex(t, i), k)) {
-        ++on;
-      } else {
-        off[n_off++] = i;
-      }
-    }
-    if (on >= 2) continue;
-    if (!TriangleMeetsSegment(x[0], x[1], x[2], s0, s1)) continue;
-    if (on == 1 && geom::Orient2d(s0, s1, x[off[0]]) * geom::Orient2d(s0, s1, x[off[1]]) >= 0) continue;
-    return true;
+    if (MeetsSegmentPart(t, k, region_.segments[k][0], region_.segments[k][1])) return true;
   }
   return false;
+}
+
+bool FacetMesh::MeetsSegmentPart(TriId2 t, size_t k, Vec2 a, Vec2 b) const {
+  const std::array<Vec2, 3> x = {dt_.Point(dt_.TriVertex(t, 0)), dt_.Point(dt_.TriVertex(t, 1)),
+                                 dt_.Point(dt_.TriVertex(t, 2))};
+  const Vec2 s0 = region_.segments[k][0], s1 = region_.segments[k][1];
+  int on = 0;
+  std::array<int, 3> off{};
+  int n_off = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (OnSegment(dt_.TriVertex(t, i), k)) {
+      ++on;
+    } else {
+      off[n_off++] = i;
+    }
+  }
+  if (on >= 2) return false;
+  if (!TriangleMeetsSegment(x[0], x[1], x[2], a, b)) return false;
+  if (on == 1 && geom::Orient2d(s0, s1, x[off[0]]) * geom::Orient2d(s0, s1, x[off[1]]) >= 0) return false;
+  return true;
+}
+
+int32_t FacetMesh::RegionSegment(uint32_t seg) const {
+  const auto& ids = region_.segment_ids;
+  for (size_t k = 0; k < ids.size(); ++k) {
+    if (ids[k] == seg) return static_cast<int32_t>(k);
+  }
+  return -1;
 }
 
 std::vector<std::array<PointId, 3>> FacetMesh::InFacetTriangles() const {

@@ -128,6 +128,13 @@ class FacetMesh {
   // vertices known to lie on each segment (SetOnSegment, and the segments'
   // endpoints), not by rounding (see facet_mesh.cc).
   bool InFacet(TriId2 t) const;
+  // Triangle t meets the open part (a, b) of region segment k's line, decided
+  // as InFacet decides it: two vertices of t on segment k (an edge of t on
+  // its line) never meet it, whatever the rounding of a and b says; one
+  // vertex on it, only if the other two are strictly on opposite sides.
+  bool MeetsSegmentPart(TriId2 t, size_t k, geom::Vec2 a, geom::Vec2 b) const;
+  // The index k in region().segment_ids of global segment seg, or -1.
+  int32_t RegionSegment(uint32_t seg) const;
   // Vertex v is a point of region segment k (a segment mesh's Steiner point);
   // call before SyncTriangleBalls for the insertion that created v.
   void SetOnSegment(VertexId2 v, int32_t k);

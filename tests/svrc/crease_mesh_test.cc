@@ -444,6 +444,34 @@ TEST(CreaseMesh, HingeYieldChainsStayShort) {
   EXPECT_LE(stats->Get("svrc.max_yield_chain", 1e9), 200);
 }
 
+// f_real/hinge.stl at radius_edge 1.414 (the crease bench's row): a triangle
+// of facet 480 with its edge (10858, 187) on segment 223 was "straddled" by
+// the pieces of that segment under the edge, whose rounded points zigzag
+// 1e-17 across the edge's line; each yield split one more piece, and the
+// warps could not take the new points (on the chord, inside the circumdisk by
+// less than its 1e-9 margin). One Destroy ran 28,000 yields down to pieces of
+// 3e-12 with no progress report, for the bench's whole 900 s timeout. The
+// straddle test now reads the vertices known to lie on the segment, as
+// InFacet does. Under a 60,000-vertex budget the run reaches the budget with
+// short chains (102 yields at most at 100,000).
+TEST(CreaseMesh, HingeTightBoundEdgeOnSegmentIsNotStraddled) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("f_real/hinge.stl"));
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  core::MeshParams params;
+  params.radius_edge = 1.414;
+  params.max_vertices = 60000;
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(*plc, params);
+  ASSERT_FALSE(m.ok()) << "hinge.stl meshes at 1.414 within 60,000 vertices now: check it in full";
+  EXPECT_NE(m.status().message().find("vertex budget of 60000"), std::string::npos) << m.status();
+  const std::optional<mesh::MeshStats> stats = mesh::StatsOf(m.status());
+  ASSERT_TRUE(stats.has_value()) << "no counters on the failed status";
+  EXPECT_GT(stats->Get("svrc.straddle_yields"), 0);
+  EXPECT_LE(stats->Get("svrc.max_yield_chain", 1e9), 500);
+}
+
 // f_real/hinge.stl in full (LONG_: ~10 min, 1.4 GB; scripts/test.sh leaves
 // LONG_ tests out, `ctest --test-dir build/release -R LONG_` runs them). The
 // input of two session-7 bugs: (1) a kept Delaunay edge pierced facet 149
