@@ -286,6 +286,11 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
       if (complex->points[i].crease) sliver.crease_vertex[i] = 1;  // refiner point i = complex point i
     }
   }
+  // SVRC_DUMP_NONCONFORMING (debugging aid, below): the tets before the flips.
+  const char* dump_env = std::getenv("SVRC_DUMP_NONCONFORMING");
+  const bool dumping = dump_env != nullptr && *dump_env != '\0';
+  std::vector<std::array<uint32_t, 4>> tets_before_flips;
+  if (dumping && use_collars) tets_before_flips = refined->tets;
   absl::StatusOr<refine::SliverResult> flipped = refine::RemoveSlivers(
       refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver);
   if (!flipped.ok()) return flipped.status();
@@ -309,6 +314,28 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                   crease_head, "the stitched mesh does not seal the facets: ", out.status().message()))
                             : absl::InternalError(absl::StrCat("SVRC: the output mesh does not seal the facets of a ",
                                                                "closed PLC: ", out.status().message()));
+      // Debugging aid (SVRC_DUMP_NONCONFORMING, as below): where the facets
+      // leak, by the conformity checker on the whole box, before and after
+      // the flips.
+      if (dumping) {
+        for (int stage = 0; stage < 2; ++stage) {
+          if (stage == 0 && tets_before_flips.empty()) continue;
+          mesh::MeshStats scratch;
+          absl::StatusOr<refine::OutputStageResult> boxed = refine::BuildOutputMesh(
+              plc, refined->normalised_positions, stage == 0 ? tets_before_flips : refined->tets,
+              complex->point_of_vertex, faces, map, /*keep_box=*/true, &scratch);
+          if (!boxed.ok()) {
+            std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %s flips: %s\n", stage == 0 ? "before" : "after",
+                         boxed.status().ToString().c_str());
+            continue;
+          }
+          mesh::ConformityOptions box_options;
+          box_options.keep_bounding_box = true;
+          const mesh::ConformityReport rep = mesh::CheckConformity(plc, boxed->mesh, box_options);
+          std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: the unsealed mesh with its box, %s the flips: %s\n",
+                       stage == 0 ? "before" : "after", rep.Summary().c_str());
+        }
+      }
       mesh::AttachStats(stats, &st);
       return st;
     }
@@ -336,9 +363,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
       // refused mesh, written where SVRC_DUMP_NONCONFORMING points (any
       // format of mesh::WriteMeshFile), so it can be studied without
       // re-running a long job. Never set in production.
-      if (const char* dump = std::getenv("SVRC_DUMP_NONCONFORMING"); dump != nullptr && *dump != '\0') {
-        const absl::Status ws = mesh::WriteMeshFile(mesh, dump);
-        std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %s: %s\n", dump, ws.ok() ? "written" : ws.ToString().c_str());
+      if (dumping) {
+        const absl::Status ws = mesh::WriteMeshFile(mesh, dump_env);
+        std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %s: %s\n", dump_env, ws.ok() ? "written" : ws.ToString().c_str());
       }
       absl::Status st = absl::FailedPreconditionError(
           absl::StrCat(crease_head, "the stitched mesh next to the creases does not conform: ", check.Summary()));
