@@ -334,6 +334,44 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
           const mesh::ConformityReport rep = mesh::CheckConformity(plc, boxed->mesh, box_options);
           std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: the unsealed mesh with its box, %s the flips: %s\n",
                        stage == 0 ? "before" : "after", rep.Summary().c_str());
+          // Before the flips, the tets near each uncovered facet (a vertex in
+          // its box grown by its diameter), to DUMP.facetN.vtu: small enough
+          // to study where a whole mesh of millions of tets is not.
+          for (const mesh::Violation& v : rep.violations) {
+            if (stage != 0 || v.kind != mesh::ViolationKind::kFacetNotCovered || v.ids.empty()) continue;
+            const int64_t f = v.ids[0];
+            if (f < 0 || static_cast<size_t>(f) >= plc.facets.size()) continue;
+            geom::Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+            for (const auto& poly : plc.facets[f].polygons) {
+              for (uint32_t i : poly.vertices) {
+                const geom::Vec3& x = plc.vertices[i];
+                lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+                hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+              }
+            }
+            const double grow = geom::Dist(lo, hi);
+            lo = lo - geom::Vec3{grow, grow, grow};
+            hi = hi + geom::Vec3{grow, grow, grow};
+            mesh::TetMesh near = boxed->mesh;
+            near.tets.clear();
+            near.tet_region.clear();
+            near.triangles.clear();
+            near.triangle_marker.clear();
+            for (size_t t = 0; t < boxed->mesh.tets.size(); ++t) {
+              bool in = false;
+              for (uint32_t q : boxed->mesh.tets[t]) {
+                const geom::Vec3& x = boxed->mesh.positions[q];
+                in = in || (x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y && x.z >= lo.z && x.z <= hi.z);
+              }
+              if (!in) continue;
+              near.tets.push_back(boxed->mesh.tets[t]);
+              if (!boxed->mesh.tet_region.empty()) near.tet_region.push_back(boxed->mesh.tet_region[t]);
+            }
+            const std::string path = absl::StrCat(dump_env, ".facet", f, ".vtu");
+            const absl::Status ws = mesh::WriteMeshFile(near, path);
+            std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %zu tets near facet %lld: %s: %s\n", near.tets.size(),
+                         static_cast<long long>(f), path.c_str(), ws.ok() ? "written" : ws.ToString().c_str());
+          }
         }
       }
       mesh::AttachStats(stats, &st);
