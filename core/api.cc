@@ -159,6 +159,70 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
 
 // A PLC with segments or facets: SVRC refinement (core/svrc, thesis ch. 3),
 // then region labelling and assembly (docs/svrc-output.md).
+// SVRC_DUMP_NONCONFORMING on an unsealed mesh (the labelling flooded every
+// tet as exterior, so there is no mesh to write): the conformity checker on
+// the whole mesh with its box, on the tets before the sliver flips (if kept)
+// and after them, to stderr; and, before the flips, the tets near each
+// uncovered facet (a vertex in its box grown by its diameter) to
+// DUMP.facetN.vtu, small enough to study where millions of tets are not.
+void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& refined,
+                      const std::vector<refine::ConstrainedFace>& faces, const refine::CoordinateMap& map,
+                      const std::vector<plc::PointId>& point_of_vertex,
+                      const std::vector<std::array<uint32_t, 4>>& tets_before_flips, const char* dump) {
+  for (int stage = 0; stage < 2; ++stage) {
+    if (stage == 0 && tets_before_flips.empty()) continue;
+    const char* when = stage == 0 ? "before" : "after";
+    mesh::MeshStats scratch;
+    absl::StatusOr<refine::OutputStageResult> boxed =
+        refine::BuildOutputMesh(plc, refined.normalised_positions, stage == 0 ? tets_before_flips : refined.tets,
+                                point_of_vertex, faces, map, /*keep_box=*/true, &scratch);
+    if (!boxed.ok()) {
+      std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %s the flips: %s\n", when, boxed.status().ToString().c_str());
+      continue;
+    }
+    mesh::ConformityOptions box_options;
+    box_options.keep_bounding_box = true;
+    const mesh::ConformityReport rep = mesh::CheckConformity(plc, boxed->mesh, box_options);
+    std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: the unsealed mesh with its box, %s the flips: %s\n", when,
+                 rep.Summary().c_str());
+    for (const mesh::Violation& v : rep.violations) {
+      if (stage != 0 || v.kind != mesh::ViolationKind::kFacetNotCovered || v.ids.empty()) continue;
+      const int64_t f = v.ids[0];
+      if (f < 0 || static_cast<size_t>(f) >= plc.facets.size()) continue;
+      geom::Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+      for (const auto& poly : plc.facets[f].polygons) {
+        for (uint32_t i : poly.vertices) {
+          const geom::Vec3& x = plc.vertices[i];
+          lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+          hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+        }
+      }
+      const double grow = geom::Dist(lo, hi);
+      lo = lo - geom::Vec3{grow, grow, grow};
+      hi = hi + geom::Vec3{grow, grow, grow};
+      mesh::TetMesh near = boxed->mesh;
+      near.tets.clear();
+      near.tet_region.clear();
+      near.triangles.clear();
+      near.triangle_marker.clear();
+      for (size_t t = 0; t < boxed->mesh.tets.size(); ++t) {
+        bool in = false;
+        for (uint32_t q : boxed->mesh.tets[t]) {
+          const geom::Vec3& x = boxed->mesh.positions[q];
+          in = in || (x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y && x.z >= lo.z && x.z <= hi.z);
+        }
+        if (!in) continue;
+        near.tets.push_back(boxed->mesh.tets[t]);
+        if (!boxed->mesh.tet_region.empty()) near.tet_region.push_back(boxed->mesh.tet_region[t]);
+      }
+      const std::string path = absl::StrCat(dump, ".facet", f, ".vtu");
+      const absl::Status ws = mesh::WriteMeshFile(near, path);
+      std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %zu tets near facet %lld: %s: %s\n", near.tets.size(),
+                   static_cast<long long>(f), path.c_str(), ws.ok() ? "written" : ws.ToString().c_str());
+    }
+  }
+}
+
 absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams& params,
                                           const ProgressCallback& progress, const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
@@ -314,65 +378,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                   crease_head, "the stitched mesh does not seal the facets: ", out.status().message()))
                             : absl::InternalError(absl::StrCat("SVRC: the output mesh does not seal the facets of a ",
                                                                "closed PLC: ", out.status().message()));
-      // Debugging aid (SVRC_DUMP_NONCONFORMING, as below): where the facets
-      // leak, by the conformity checker on the whole box, before and after
-      // the flips.
+      // Debugging aid (SVRC_DUMP_NONCONFORMING, as below): where the facets leak.
       if (dumping) {
-        for (int stage = 0; stage < 2; ++stage) {
-          if (stage == 0 && tets_before_flips.empty()) continue;
-          mesh::MeshStats scratch;
-          absl::StatusOr<refine::OutputStageResult> boxed = refine::BuildOutputMesh(
-              plc, refined->normalised_positions, stage == 0 ? tets_before_flips : refined->tets,
-              complex->point_of_vertex, faces, map, /*keep_box=*/true, &scratch);
-          if (!boxed.ok()) {
-            std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %s flips: %s\n", stage == 0 ? "before" : "after",
-                         boxed.status().ToString().c_str());
-            continue;
-          }
-          mesh::ConformityOptions box_options;
-          box_options.keep_bounding_box = true;
-          const mesh::ConformityReport rep = mesh::CheckConformity(plc, boxed->mesh, box_options);
-          std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: the unsealed mesh with its box, %s the flips: %s\n",
-                       stage == 0 ? "before" : "after", rep.Summary().c_str());
-          // Before the flips, the tets near each uncovered facet (a vertex in
-          // its box grown by its diameter), to DUMP.facetN.vtu: small enough
-          // to study where a whole mesh of millions of tets is not.
-          for (const mesh::Violation& v : rep.violations) {
-            if (stage != 0 || v.kind != mesh::ViolationKind::kFacetNotCovered || v.ids.empty()) continue;
-            const int64_t f = v.ids[0];
-            if (f < 0 || static_cast<size_t>(f) >= plc.facets.size()) continue;
-            geom::Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-            for (const auto& poly : plc.facets[f].polygons) {
-              for (uint32_t i : poly.vertices) {
-                const geom::Vec3& x = plc.vertices[i];
-                lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
-                hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
-              }
-            }
-            const double grow = geom::Dist(lo, hi);
-            lo = lo - geom::Vec3{grow, grow, grow};
-            hi = hi + geom::Vec3{grow, grow, grow};
-            mesh::TetMesh near = boxed->mesh;
-            near.tets.clear();
-            near.tet_region.clear();
-            near.triangles.clear();
-            near.triangle_marker.clear();
-            for (size_t t = 0; t < boxed->mesh.tets.size(); ++t) {
-              bool in = false;
-              for (uint32_t q : boxed->mesh.tets[t]) {
-                const geom::Vec3& x = boxed->mesh.positions[q];
-                in = in || (x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y && x.z >= lo.z && x.z <= hi.z);
-              }
-              if (!in) continue;
-              near.tets.push_back(boxed->mesh.tets[t]);
-              if (!boxed->mesh.tet_region.empty()) near.tet_region.push_back(boxed->mesh.tet_region[t]);
-            }
-            const std::string path = absl::StrCat(dump_env, ".facet", f, ".vtu");
-            const absl::Status ws = mesh::WriteMeshFile(near, path);
-            std::fprintf(stderr, "SVRC_DUMP_NONCONFORMING: %zu tets near facet %lld: %s: %s\n", near.tets.size(),
-                         static_cast<long long>(f), path.c_str(), ws.ok() ? "written" : ws.ToString().c_str());
-          }
-        }
+        DiagnoseUnsealed(plc, *refined, faces, map, complex->point_of_vertex, tets_before_flips, dump_env);
       }
       mesh::AttachStats(stats, &st);
       return st;
