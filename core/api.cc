@@ -157,8 +157,6 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
   return budget;
 }
 
-// A PLC with segments or facets: SVRC refinement (core/svrc, thesis ch. 3),
-// then region labelling and assembly (docs/svrc-output.md).
 // SVRC_DUMP_NONCONFORMING on an unsealed mesh (the labelling flooded every
 // tet as exterior, so there is no mesh to write): the conformity checker on
 // the whole mesh with its box, on the tets before the sliver flips (if kept)
@@ -223,6 +221,8 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
   }
 }
 
+// A PLC with segments or facets: SVRC refinement (core/svrc, thesis ch. 3),
+// then region labelling and assembly (docs/svrc-output.md).
 absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams& params,
                                           const ProgressCallback& progress, const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
