@@ -196,6 +196,7 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
         }
       }
       const double grow = geom::Dist(lo, hi);
+      const geom::Vec3 flo = lo, fhi = hi;  // the facet's own box
       lo = lo - geom::Vec3{grow, grow, grow};
       hi = hi + geom::Vec3{grow, grow, grow};
       mesh::TetMesh near = boxed->mesh;
@@ -212,6 +213,43 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
         if (!in) continue;
         near.tets.push_back(boxed->mesh.tets[t]);
         if (!boxed->mesh.tet_region.empty()) near.tet_region.push_back(boxed->mesh.tet_region[t]);
+      }
+      // The points lying (nearly) on the facet's plane inside its box that are
+      // no corner of its constrained faces: the faces around such a point
+      // cover part of F but are not F's (the labelling floods through them).
+      // Each with its containment dimension pair, creation index and whether
+      // it is inside a collar ball: which construction made it.
+      {
+        const auto& ring = plc.facets[f].polygons[0].vertices;
+        geom::Vec3 n{0, 0, 0};
+        for (size_t i = 0; i < ring.size(); ++i) {
+          n = n + geom::Cross(plc.vertices[ring[i]], plc.vertices[ring[(i + 1) % ring.size()]]);
+        }
+        n = n * (1 / std::sqrt(geom::Dot(n, n)));
+        const geom::Vec3 o = plc.vertices[ring[0]];
+        std::vector<uint8_t> corner(refined.positions.size());
+        for (const refine::ConstrainedFace& cf : faces) {
+          if (cf.facet != static_cast<uint32_t>(f)) continue;
+          for (uint32_t q : cf.v) corner[q] = 1;
+        }
+        for (size_t q = 0; q < refined.positions.size(); ++q) {
+          const geom::Vec3& x = refined.positions[q];
+          if (corner[q] ||
+              !(x.x >= flo.x && x.x <= fhi.x && x.y >= flo.y && x.y <= fhi.y && x.z >= flo.z && x.z <= fhi.z)) {
+            continue;
+          }
+          const double h = geom::Dot(x - o, n);
+          if (!(std::fabs(h) < 1e-12 * grow)) continue;
+          double collar = HUGE_VAL;  // the nearest collar ball's distance over its radius
+          const geom::Vec3 xn = refined.normalised_positions[q];
+          for (const auto& c : refined.collars) collar = std::min(collar, geom::Dist(xn, c.center) / c.radius);
+          std::fprintf(stderr,
+                       "SVRC_DUMP_NONCONFORMING: facet %lld: point %zu (%.17g, %.17g, %.17g) is %.3g off its plane "
+                       "and no corner of its faces: cd pair %d, %s, nearest collar at %.6g radii\n",
+                       static_cast<long long>(f), q, x.x, x.y, x.z, h,
+                       q < refined.point_cd.size() ? refined.point_cd[q] : -1,
+                       q < refined.num_input ? "an input point" : "a Steiner point", collar);
+        }
       }
       const std::string path = absl::StrCat(dump, ".facet", f, ".vtu");
       const absl::Status ws = mesh::WriteMeshFile(near, path);
