@@ -15,6 +15,7 @@
 #include "client/command.h"
 #include "core/codec/container.h"
 #include "core/plc/readers.h"
+#include "core/util/huge_pages.h"
 
 namespace svrc::cli {
 namespace {
@@ -57,6 +58,19 @@ int RunMesh(const std::vector<std::string>& argv) {
                     ? kExitInvalidInput
                     : ExitCodeFor(plc.status(), true),
                 std::string(plc.status().message()));
+  }
+  // A long job re-executes this command once with its heap on transparent huge
+  // pages (core/util/huge_pages.h; cube --max-volume 1e-6 19.7 → 16.4 s wall,
+  // wedge-1.smesh 26.1 → 22.5 s). Small ones do not: the second start-up would
+  // double their time. Returns only if it did not re-execute.
+  if (absl::StatusOr<core::MeshParams> params = ToMeshParams(*options);
+      params.ok() && core::ExpectLongRun(*plc, *params)) {
+    std::vector<std::string> words{"svrc", "mesh"};
+    words.insert(words.end(), argv.begin(), argv.end());
+    std::vector<char*> exec_argv;
+    for (std::string& w : words) exec_argv.push_back(w.data());
+    exec_argv.push_back(nullptr);
+    util::ReexecWithHugePageHeap(exec_argv.data());
   }
   core::CancelToken cancel;
   if (options->deadline > absl::ZeroDuration()) {
@@ -105,6 +119,7 @@ int RunMesh(const std::vector<std::string>& argv) {
               mesh->num_vertices(), mesh->num_tets(), mesh->triangles.size(), seconds);
   if (args->switches.count("--stats")) {
     PrintCounters(mesh->stats);
+    std::printf("  %-34s %d\n", "cli.huge_page_heap", util::HugePageHeapRequested() ? 1 : 0);
     std::fputs(mesh::FormatQualityReport(mesh::ComputeQuality(*mesh)).c_str(), stdout);
   }
   return kExitOk;

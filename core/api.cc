@@ -99,6 +99,9 @@ absl::StatusOr<mesh::TetMesh> MeshPointSet(const plc::Plc& plc, const ProgressCa
 // at X degrees" / "crease at point i (x, y, z)"; empty if none.
 // `sharpest` receives the smallest crease angle in degrees (0 for a crease
 // point off every crease segment: segments meeting at an acute angle).
+// Creases at least this sharp are refined through (no collars); sharper ones get collars.
+constexpr double kCollarAngleDeg = 45;
+
 std::string FirstCrease(const plc::FeatureComplex& complex, double* sharpest) {
   *sharpest = 90;
   std::string first;
@@ -156,6 +159,23 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
   if (params.max_vertices != 0) budget = std::min<uint64_t>(budget, params.max_vertices);
   return budget;
 }
+
+}  // namespace
+
+bool ExpectLongRun(const plc::Plc& plc, const MeshParams& params) {
+  if (params.max_volume > 0) return true;
+  for (const plc::RegionSeed& r : plc.regions) {
+    if (r.max_volume > 0) return true;
+  }
+  if (plc.vertices.size() >= 1000) return true;
+  if (plc.segments.empty() && plc.facets.empty()) return false;
+  absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(plc, {}, {}, nullptr);
+  if (!complex.ok()) return false;
+  double sharpest = 90;
+  return !FirstCrease(*complex, &sharpest).empty() && sharpest < kCollarAngleDeg;
+}
+
+namespace {
 
 // SVRC_DUMP_NONCONFORMING on an unsealed mesh (the labelling flooded every
 // tet as exterior, so there is no mesh to write): the conformity checker on
@@ -325,7 +345,6 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   // cannot finish yet ends FAILED_PRECONDITION naming its sharpest crease.
   double sharpest = 90;
   const std::string crease = FirstCrease(*complex, &sharpest);
-  constexpr double kCollarAngleDeg = 45;
   const bool use_collars = !crease.empty() && sharpest < kCollarAngleDeg;
   // The head of every collar-stage error: the crease and its angle.
   const std::string crease_head = absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest, " degrees): ");

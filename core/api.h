@@ -91,6 +91,14 @@ absl::StatusOr<mesh::TetMesh> MeshPlc(const plc::Plc& plc, const MeshParams& par
                                       const ProgressCallback& progress = nullptr,
                                       const CancelToken* cancel = nullptr);
 
+// Whether meshing `plc` with `params` is likely to take more than a second and
+// hundreds of MB: a max_volume (global or per region), 1,000 or more input
+// vertices, or a crease below 45 degrees (the collar path). The CLI re-executes
+// itself with a huge-page heap for such jobs only (core/util/huge_pages.h): the
+// second start-up costs about as much as a small job. A guess, not a bound;
+// false for an input PreparePlc refuses.
+bool ExpectLongRun(const plc::Plc& plc, const MeshParams& params);
+
 // "svrc <major>.<minor>.<patch>", for provenance in every result.
 std::string Version();
 

@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "core/api.h"
+#include "core/util/huge_pages.h"
 #include "server/log.h"
 #include "server/server.h"
 
@@ -45,6 +46,9 @@ int Usage(const std::string& why) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // The workers' heaps on transparent huge pages (core/util/huge_pages.h).
+  // Returns only if it did not re-execute.
+  svrc::util::ReexecWithHugePageHeap(argv);
   using svrc::server::ServerOptions;
   ServerOptions options;
   for (int i = 1; i < argc; ++i) {

@@ -3,6 +3,7 @@
 // line; get/list/cancel/health work; exit statuses follow client/command.h
 // (2 usage, 3 invalid input, 4 server, 5 job failed, 6 cancelled/deadline).
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "absl/strings/match.h"
@@ -252,6 +253,42 @@ TEST(CliSplitTest, HelpListsTheRemoteCommandsAndAMissingRemoteBinaryIsNamed) {
   const testing::CommandResult v =
       testing::RunCommand({lone, "validate", testing::CorpusPath("a_convex/cube.poly"), "-q"});
   EXPECT_EQ(v.exit_code, 0) << v.err;
+  fs::remove_all(dir);
+}
+
+// core/util/huge_pages.h: a long local job re-executes itself once with
+// glibc.malloc.hugetlb=1 when transparent huge pages are in madvise mode, a
+// small one does not, SVRC_HUGE_PAGES=0 turns it off, and the output bytes do
+// not depend on it.
+TEST(CliHugePagesTest, LongJobsRunOnAHugePageHeapWithTheSameOutput) {
+  std::string mode;
+  {
+    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+    std::getline(in, mode);
+  }
+  const bool madvise = absl::StrContains(mode, "[madvise]");
+  const std::string dir = testing::MakeTempDir("cli_huge");
+  const std::string cube = testing::CorpusPath("a_convex/cube.poly");
+  auto flag = [](const testing::CommandResult& r) {
+    if (absl::StrContains(r.out, "cli.huge_page_heap                 1")) return 1;
+    if (absl::StrContains(r.out, "cli.huge_page_heap                 0")) return 0;
+    return -1;
+  };
+  const testing::CommandResult small = RunSvrc({"mesh", cube, "-o", dir + "/small.node", "--quiet", "--stats"});
+  ASSERT_EQ(small.exit_code, 0) << small.err;
+  EXPECT_EQ(flag(small), 0) << small.out;  // no max_volume, 8 points, no crease: not worth a second start-up
+  const testing::CommandResult big =
+      RunSvrc({"mesh", cube, "--max-volume", "1e-3", "-o", dir + "/big.node", "--quiet", "--stats"});
+  ASSERT_EQ(big.exit_code, 0) << big.err;
+  EXPECT_EQ(flag(big), madvise ? 1 : 0) << mode << "\n" << big.out;
+  const testing::CommandResult off =
+      testing::RunCommand({"/usr/bin/env", "SVRC_HUGE_PAGES=0", testing::SvrcCliPath(), "mesh", cube, "--max-volume",
+                           "1e-3", "-o", dir + "/off.node", "--quiet", "--stats"});
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  EXPECT_EQ(flag(off), 0) << off.out;
+  for (const char* ext : {".node", ".ele", ".face"}) {
+    EXPECT_EQ(testing::ReadFileOrFail(dir + "/big" + ext), testing::ReadFileOrFail(dir + "/off" + ext)) << ext;
+  }
   fs::remove_all(dir);
 }
 

@@ -70,6 +70,32 @@ TEST(MeshPlcTest, OutOfMemoryIsAnErrorNotACrash) {
   EXPECT_EQ(WEXITSTATUS(status), 0) << "10: setrlimit, 11: meshed, 12: another code, 13: another message";
 }
 
+// The CLI's guess of a long job (the huge-page re-execution's gate).
+TEST(ExpectLongRunTest, MaxVolumeManyPointsOrASharpCrease) {
+  MeshParams params;
+  auto read = [](const char* rel) {
+    absl::StatusOr<plc::Plc> p = plc::ReadPlcFile(testing::CorpusPath(rel));
+    EXPECT_TRUE(p.ok()) << rel << ": " << p.status();
+    return p.ok() ? *p : plc::Plc{};
+  };
+  const plc::Plc cube = read("a_convex/cube.poly");
+  EXPECT_FALSE(ExpectLongRun(cube, params));
+  // Creases at 70.5 degrees are refined through without collars.
+  EXPECT_FALSE(ExpectLongRun(read("a_convex/tetra.poly"), params));
+  EXPECT_TRUE(ExpectLongRun(read("b_internal/example.poly"), params));  // regions with max volumes
+  EXPECT_TRUE(ExpectLongRun(read("c_creases/knife_edge.poly"), params));  // collars
+  EXPECT_TRUE(ExpectLongRun(read("f_real/bunny.off"), params));          // 34,834 points
+  plc::Plc regional = cube;
+  regional.regions.push_back({{0.5, 0.5, 0.5}, 1, 1e-3});
+  EXPECT_TRUE(ExpectLongRun(regional, params));
+  params.max_volume = 1e-3;
+  EXPECT_TRUE(ExpectLongRun(cube, params));
+  plc::Plc broken = read("c_creases/knife_edge.poly");
+  broken.facets[0].polygons[0].vertices[0] = 1u << 30;  // refused by PreparePlc: no guess
+  params.max_volume = 0;
+  EXPECT_FALSE(ExpectLongRun(broken, params));
+}
+
 TEST(VersionTest, NamesTheProject) { EXPECT_EQ(Version().rfind("svrc ", 0), 0u); }
 
 }  // namespace
