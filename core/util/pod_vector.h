@@ -17,6 +17,9 @@
 // (realloc moves bytes).
 #pragma once
 
+#include <malloc.h>
+
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -26,6 +29,13 @@
 #include <utility>
 
 namespace svrc::util {
+
+// Heap accounting for PodVector's blocks, which bypass operator new: when
+// set (the server's per-job memory budget, server/memory_accounting.h), it is
+// called on the allocating thread with the change in usable bytes each time a
+// PodVector allocates, grows, shrinks or frees its block.
+using PodHeapHook = void (*)(int64_t delta_bytes);
+inline std::atomic<PodHeapHook> pod_heap_hook{nullptr};
 
 template <typename T>
 class PodVector {
@@ -63,7 +73,7 @@ class PodVector {
   }
   PodVector& operator=(PodVector&& o) noexcept {
     if (this != &o) {
-      std::free(raw_);
+      Release(raw_);
       raw_ = std::exchange(o.raw_, nullptr);
       data_ = std::exchange(o.data_, nullptr);
       size_ = std::exchange(o.size_, 0);
@@ -71,7 +81,7 @@ class PodVector {
     }
     return *this;
   }
-  ~PodVector() { std::free(raw_); }
+  ~PodVector() { Release(raw_); }
 
   size_t size() const { return size_; }
   size_t capacity() const { return cap_; }
@@ -120,7 +130,7 @@ class PodVector {
   void shrink_to_fit() {
     if (size_ == cap_) return;
     if (size_ == 0) {
-      std::free(raw_);
+      Release(raw_);
       raw_ = nullptr;
       data_ = nullptr;
       cap_ = 0;
@@ -136,10 +146,20 @@ class PodVector {
   }
 
  private:
+  static void Release(void* raw) {
+    if (raw == nullptr) return;
+    if (const PodHeapHook hook = pod_heap_hook.load(std::memory_order_relaxed)) {
+      hook(-static_cast<int64_t>(malloc_usable_size(raw)));
+    }
+    std::free(raw);
+  }
   void Reallocate(size_t n) {
     const size_t old_offset = raw_ == nullptr ? 0 : reinterpret_cast<char*>(data_) - static_cast<char*>(raw_);
+    const PodHeapHook hook = pod_heap_hook.load(std::memory_order_relaxed);
+    const int64_t before = hook != nullptr && raw_ != nullptr ? static_cast<int64_t>(malloc_usable_size(raw_)) : 0;
     void* p = std::realloc(raw_, n * sizeof(T) + kSlack);
     if (p == nullptr) throw std::bad_alloc();
+    if (hook != nullptr) hook(static_cast<int64_t>(malloc_usable_size(p)) - before);
     char* base = static_cast<char*>(p);
     const size_t offset = kSlack == 0 ? 0 : (alignof(T) - reinterpret_cast<uintptr_t>(base) % alignof(T)) % alignof(T);
     if (offset != old_offset && size_ > 0) std::memmove(base + offset, base + old_offset, size_ * sizeof(T));

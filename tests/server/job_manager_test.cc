@@ -2,6 +2,7 @@
 // validation at submit, cancel of queued and running jobs, delete, paging,
 // and shutdown. Results are compared byte for byte with a local run.
 #include "server/job_manager.h"
+#include "server/memory_accounting.h"
 
 #include <filesystem>
 #include <mutex>
@@ -10,6 +11,7 @@
 #include "client/mesh_job.h"
 #include "core/codec/container.h"
 #include "core/plc/readers.h"
+#include "core/util/pod_vector.h"
 #include "gtest/gtest.h"
 #include "tests/server/job_test_util.h"
 #include "tests/server/service_test_util.h"
@@ -50,6 +52,26 @@ std::string LocalContainer(const std::string& node) {
   absl::StatusOr<std::string> bytes = codec::EncodeTetMesh(*mesh, codec::EncodeOptions());
   EXPECT_TRUE(bytes.ok()) << bytes.status();
   return *bytes;
+}
+
+// The per-job heap budget counts util::PodVector's blocks (the refinement's
+// largest arrays: Delaunay tets, points, location-graph pools), which come
+// from realloc and bypassed the operator new count before session 23.
+TEST(JobMemoryTest, PodVectorBlocksCountOnTheJobsThread) {
+  if (!MemoryAccountingActive()) GTEST_SKIP() << "the sanitizer owns the allocator";
+  JobMemory memory;
+  BindThreadMemory(&memory);
+  int64_t held = 0;
+  {
+    util::PodVector<double> v;
+    v.resize(1 << 20);  // 8 MiB
+    held = memory.bytes.load();
+  }
+  const int64_t after = memory.bytes.load();
+  BindThreadMemory(nullptr);
+  EXPECT_GE(held, int64_t{8} << 20);
+  EXPECT_GE(memory.peak.load(), int64_t{8} << 20);
+  EXPECT_LT(after, int64_t{1} << 20);
 }
 
 TEST(JobManagerTest, PointSetJobSucceedsWithTheLocalBytes) {

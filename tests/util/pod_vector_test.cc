@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <malloc.h>
 #include <random>
 #include <vector>
 
@@ -152,6 +153,44 @@ TEST(PodVectorTest, GrowsLargeArraysWithoutASecondCopy) {
   EXPECT_LT(pod, final_mib * 115 / 100) << "PodVector peak " << pod << " MiB";
   // The comparison that makes the test mean something on this allocator.
   EXPECT_GT(vec, final_mib * 140 / 100) << "std::vector peak " << vec << " MiB";
+}
+
+// pod_heap_hook: every block's usable bytes are reported when allocated,
+// grown, shrunk and freed (moves report nothing), so a job's heap account
+// (server/memory_accounting.h) ends where it started.
+int64_t hook_bytes = 0;
+int64_t hook_calls = 0;
+void CountHook(int64_t delta) {
+  hook_bytes += delta;
+  ++hook_calls;
+}
+
+TEST(PodVectorTest, HeapHookSeesEveryBlockAndBalances) {
+  pod_heap_hook.store(&CountHook);
+  {
+    PodVector<double> a;
+    EXPECT_EQ(hook_calls, 0);
+    a.resize(1000);
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(a.data())));
+    for (int i = 0; i < 100000; ++i) a.push_back(i);  // grows by doubling
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(a.data())));
+    EXPECT_GE(hook_bytes, static_cast<int64_t>(101000 * sizeof(double)));
+    PodVector<double> b = std::move(a);  // no allocation
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(b.data())));
+    PodVector<double> c = b;  // a second block
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(b.data()) + malloc_usable_size(c.data())));
+    c.resize(10);
+    c.shrink_to_fit();
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(b.data()) + malloc_usable_size(c.data())));
+    c.clear();
+    c.shrink_to_fit();  // frees
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(b.data())));
+    PodVector<double> d(50);
+    d = std::move(b);  // d's block freed, b's taken over
+    EXPECT_EQ(hook_bytes, static_cast<int64_t>(malloc_usable_size(d.data())));
+  }
+  EXPECT_EQ(hook_bytes, 0);
+  pod_heap_hook.store(nullptr);
 }
 
 }  // namespace
