@@ -312,7 +312,9 @@ class Refiner {
   }
   // The faces of the stitched tets lying on a facet (FacetOfTriangle), as
   // (facet, sorted point ids), in ascending face order.
-  std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> StitchedFacetFaces() const;
+  // `on_plane` (optional): how many of them have a point of Ω
+  // (RefineOptions::stitch_faces_on_plane).
+  std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> StitchedFacetFaces(uint64_t* on_plane = nullptr) const;
   // The facets containing crease point p (an input point or a point of a
   // segment), ascending: the complex's incidence lists, no search.
   std::span<const uint32_t> FacetsThrough(PointId p) const {
@@ -564,6 +566,9 @@ class Refiner {
   // Facets (stage (c)).
   std::vector<FacetMesh> facets_;
   std::vector<plc::FacetFrame> frames_;  // normalised frames
+  // The conformity checker's on-plane tolerance in normalised coordinates:
+  // 8 ulps of the PLC's largest input coordinate (docs/conformity.md).
+  double on_plane_tol_ = 0;
   uint32_t facet_mesh0_ = 0;             // MeshId of facet 0 (= its FeatureId)
   std::vector<std::vector<uint32_t>> point_facets_;  // per complex point: facets containing it
   std::vector<std::vector<uint32_t>> seg_facets_;    // per segment: facets containing it
@@ -798,6 +803,13 @@ absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const 
                                        : std::max<uint64_t>(1'000'000, 2000ull * num_input_);
   // Global ids = SoS priorities: inputs first (in input order), then corners.
   complex_ = &complex;
+  {
+    double scale = 0;
+    for (const plc::FeaturePoint& q : complex.points) {
+      scale = std::max({scale, std::fabs(q.p.x), std::fabs(q.p.y), std::fabs(q.p.z)});
+    }
+    on_plane_tol_ = std::ldexp(8 * std::numeric_limits<double>::epsilon() * scale, -norm_.exponent);
+  }
   for (uint32_t i = 0; i < num_input_; ++i) {
     points_.Add(normalised[i], features_.OfPoint(i), kCdInputVertex, options_.collars && complex.points[i].crease);
   }
@@ -2572,20 +2584,29 @@ void Refiner::ReleaseRefinementState() {
   ball_mark_ = {};
 }
 
-std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacetFaces() const {
+std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacetFaces(uint64_t* on_plane) const {
   // Only a face whose three points lie on features can be on a facet
   // (FacetsOfPoint is empty for a point of Ω). Filtering before the sort
   // keeps this list to the faces near the facets: all four faces of every
   // stitched tet were 15% of crease_pair_1deg's peak heap (75 of 506 MB).
+  // With stitch_faces_on_plane, faces with one point of Ω go to a second list
+  // (that point last), kept only if the point lies on a facet of the other two.
   std::vector<uint8_t> on_feature(points_.size());
   for (uint32_t p = 0; p < points_.size(); ++p) on_feature[p] = points_.Parent(PointId(p)) != FeatureTable::Omega();
-  std::vector<std::array<uint32_t, 3>> faces;
+  std::vector<std::array<uint32_t, 3>> faces, one_omega;
   for (const auto& t : stitched_) {
     for (int k = 0; k < 4; ++k) {
       std::array<uint32_t, 3> fc{t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4]};
-      if (!on_feature[fc[0]] || !on_feature[fc[1]] || !on_feature[fc[2]]) continue;
-      std::sort(fc.begin(), fc.end());
-      faces.push_back(fc);
+      const int omega = !on_feature[fc[0]] + !on_feature[fc[1]] + !on_feature[fc[2]];
+      if (omega == 0) {
+        std::sort(fc.begin(), fc.end());
+        faces.push_back(fc);
+      } else if (omega == 1 && options_.stitch_faces_on_plane) {
+        std::sort(fc.begin(), fc.end(), [&](uint32_t a, uint32_t b) {
+          return on_feature[a] != on_feature[b] ? on_feature[a] > on_feature[b] : a < b;
+        });
+        one_omega.push_back(fc);
+      }
     }
   }
   std::sort(faces.begin(), faces.end());
@@ -2595,6 +2616,34 @@ std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacet
   for (const auto& k : faces) {
     const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
     if (f != kNoFacet) out.emplace_back(f, k);
+  }
+  if (one_omega.empty()) return out;
+  std::sort(one_omega.begin(), one_omega.end());
+  one_omega.erase(std::unique(one_omega.begin(), one_omega.end()), one_omega.end());
+  size_t added = 0;
+  for (const auto& k : one_omega) {
+    FacetsOfPoint(PointId(k[0]), &fa);
+    FacetsOfPoint(PointId(k[1]), &fb);
+    std::erase_if(fa, [&](uint32_t f) { return !std::binary_search(fb.begin(), fb.end(), f); });
+    const Vec3& x = points_.Xyz(PointId(k[2]));
+    for (uint32_t f : fa) {
+      const plc::FacetFrame& fr = frames_[f];
+      if (!(std::fabs(geom::Dot(x - fr.origin, fr.normal)) <= on_plane_tol_)) continue;
+      const Vec2 a = Uv(f, PointId(k[0])), b = Uv(f, PointId(k[1])), c = fr.ToPlane(x);
+      const Vec2 g{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3};
+      if (facets_[f].region().Locate(g) == FacetRegion::Where::kOutside) continue;
+      std::array<uint32_t, 3> sorted = k;
+      std::sort(sorted.begin(), sorted.end());
+      out.emplace_back(f, sorted);
+      ++added;
+      break;
+    }
+  }
+  if (on_plane != nullptr) *on_plane = added;
+  if (added > 0) {
+    std::sort(out.begin(), out.end(), [](const auto& p, const auto& q) {
+      return p.second != q.second ? p.second < q.second : p.first < q.first;
+    });
   }
   return out;
 }
@@ -3460,7 +3509,7 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
     // a hole). Outside the collars these are exactly M_F's triangles (the
     // conformity of §3.2.2); inside, the stitched fans (Theorem 4's proof).
     out.facet_triangles.assign(facets_.size(), {});
-    for (const auto& [f, k] : StitchedFacetFaces()) out.facet_triangles[f].push_back(k);
+    for (const auto& [f, k] : StitchedFacetFaces(&st.stitch_faces_on_plane)) out.facet_triangles[f].push_back(k);
   }
   std::vector<VertexId> nbrs;
   for (uint32_t w = 0; w < dt.NumVertices(); ++w) {
@@ -3555,6 +3604,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   }
   out->Set("svrc.arc_repairs", static_cast<double>(arc_repairs));
   if (collars > 0) out->Set("svrc.stitched_arc_crossings", static_cast<double>(stitched_arc_crossings));
+  if (collars > 0) out->Set("svrc.stitch_faces_on_plane", static_cast<double>(stitch_faces_on_plane));
   if (collars > 0) out->Set("svrc.stitched_crossings", static_cast<double>(stitched_crossings));
   out->Set("svrc.collar_pairs", static_cast<double>(collar_pairs));
   out->Set("svrc.collar_pairs_not_smooth", static_cast<double>(collar_pairs_not_smooth));

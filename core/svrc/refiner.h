@@ -143,6 +143,15 @@ struct RefineOptions {
   // with it fandisk.off's stitched mesh leaked (docs/svrc-collars.md
   // "Session 21").
   bool collar_exact_sphere_links = false;
+  // The stitched mesh's faces on a facet F also include a face with two
+  // points on F and one point of Ω lying on F's plane within the conformity
+  // checker's tolerance (8 ulps of the PLC's largest coordinate) whose
+  // centroid is in F's region. Such a point is a Voronoi vertex of M_Ω that
+  // lies on F exactly: inside a collar, where F's points are suppressed, the
+  // Ω ball's yields to F's balls converge on it and it is inserted as a point
+  // of Ω (fandisk.off with exact sphere links, session 23). Without the rule
+  // its faces are no facet's and the labelling floods through F.
+  bool stitch_faces_on_plane = true;
   // Warp radius factor θ (§3.1.1).
   double theta = 0.9;
   // Facet meshes are refined to Voronoi aspect facet_tau_factor·τ. Only M_Ω's
@@ -289,6 +298,7 @@ struct RefineStats {
   std::array<uint64_t, 4> collar_repairs_by_reason{};
   uint64_t arc_repairs = 0;        // points inserted on facet arcs
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar
+  uint64_t stitch_faces_on_plane = 0;   // facet faces with a point of Ω on the plane (stitch_faces_on_plane)
   uint64_t stitched_crossings = 0;      // all points for stitched tets crossing a facet (arc points included)
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   uint64_t slivers_broken = 0;     // kept slivers broken by an insertion at the end (per-tet mode)
