@@ -141,7 +141,8 @@ struct RefineOptions {
   bool collar_exact_vertex_links = false;
   // CollarSurfaceOptions::exact_sphere_links (tests (d)/(f) exact). Off:
   // with it fandisk.off's stitched mesh leaked (docs/svrc-collars.md
-  // "Session 21").
+  // "Session 21"); since session 23 (stitch_faces_on_plane) it meshes, but
+  // the other long inputs have not been rerun with it.
   bool collar_exact_sphere_links = false;
   // The stitched mesh's faces on a facet F also include a face with two
   // points on F and one point of Ω lying on F's plane within the conformity
