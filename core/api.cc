@@ -95,13 +95,13 @@ absl::StatusOr<mesh::TetMesh> MeshPointSet(const plc::Plc& plc, const ProgressCa
   return out;
 }
 
+// Creases of this angle (degrees) and more are refined through without collars; sharper ones get collars.
+constexpr double kCollarAngleDeg = 45;
+
 // The first crease of the complex, as "crease at segment (a, b): features meet
 // at X degrees" / "crease at point i (x, y, z)"; empty if none.
 // `sharpest` receives the smallest crease angle in degrees (0 for a crease
 // point off every crease segment: segments meeting at an acute angle).
-// Creases at least this sharp are refined through (no collars); sharper ones get collars.
-constexpr double kCollarAngleDeg = 45;
-
 std::string FirstCrease(const plc::FeatureComplex& complex, double* sharpest) {
   *sharpest = 90;
   std::string first;
@@ -234,11 +234,11 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
         near.tets.push_back(boxed->mesh.tets[t]);
         if (!boxed->mesh.tet_region.empty()) near.tet_region.push_back(boxed->mesh.tet_region[t]);
       }
-      // The points lying (nearly) on the facet's plane inside its box that are
-      // no corner of its constrained faces: the faces around such a point
-      // cover part of F but are not F's (the labelling floods through them).
-      // Each with its containment dimension pair, creation index and whether
-      // it is inside a collar ball: which construction made it.
+      // The mesh's points lying (nearly) on the facet's plane inside its box
+      // that are no corner of its constrained faces: the faces around such a
+      // point cover part of F but are not F's (the labelling floods through
+      // them). Each with its containment dimension pair, creation index and
+      // distance to the nearest collar centre: which construction made it.
       {
         const auto& ring = plc.facets[f].polygons[0].vertices;
         geom::Vec3 n{0, 0, 0};
@@ -247,7 +247,10 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
         }
         n = n * (1 / std::sqrt(geom::Dot(n, n)));
         const geom::Vec3 o = plc.vertices[ring[0]];
-        std::vector<uint8_t> corner(refined.positions.size());
+        std::vector<uint8_t> corner(refined.positions.size(), 1);  // 1: skip (no vertex of the tets)
+        for (const auto& t : refined.tets) {
+          for (uint32_t q : t) corner[q] = 0;
+        }
         for (const refine::ConstrainedFace& cf : faces) {
           if (cf.facet != static_cast<uint32_t>(f)) continue;
           for (uint32_t q : cf.v) corner[q] = 1;
