@@ -2,6 +2,7 @@
 // pipeline as the server's workers (client/mesh_job.h), so a remote job's
 // output is byte-identical to this command's for the same input and flags.
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -60,11 +61,14 @@ int RunMesh(const std::vector<std::string>& argv) {
                 std::string(plc.status().message()));
   }
   // A long job re-executes this command once with its heap on transparent huge
-  // pages (core/util/huge_pages.h; cube --max-volume 1e-6 19.7 → 16.4 s wall,
-  // wedge-1.smesh 26.1 → 22.5 s). Small ones do not: the second start-up would
-  // double their time. Returns only if it did not re-execute.
+  // pages (core/util/huge_pages.h; docs/svrc-design.md §8 item 49: a tenth of
+  // the page faults, 5–10% less wall time). Small ones do not: the second
+  // start-up would double their time. Nor does an input that is not a regular
+  // file (a pipe, /dev/stdin): the new process could not read it again.
+  // Returns only if it did not re-execute.
+  std::error_code regular_error;
   if (absl::StatusOr<core::MeshParams> params = ToMeshParams(*options);
-      params.ok() && core::ExpectLongRun(*plc, *params)) {
+      params.ok() && std::filesystem::is_regular_file(in, regular_error) && core::ExpectLongRun(*plc, *params)) {
     std::vector<std::string> words{"svrc", "mesh"};
     words.insert(words.end(), argv.begin(), argv.end());
     std::vector<char*> exec_argv;

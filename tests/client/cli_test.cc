@@ -2,9 +2,12 @@
 // byte-identical in every output format; the job id is submit's last stdout
 // line; get/list/cancel/health work; exit statuses follow client/command.h
 // (2 usage, 3 invalid input, 4 server, 5 job failed, 6 cancelled/deadline).
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <thread>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -289,6 +292,21 @@ TEST(CliHugePagesTest, LongJobsRunOnAHugePageHeapWithTheSameOutput) {
   for (const char* ext : {".node", ".ele", ".face"}) {
     EXPECT_EQ(testing::ReadFileOrFail(dir + "/big" + ext), testing::ReadFileOrFail(dir + "/off" + ext)) << ext;
   }
+  // An input that is not a regular file cannot be read twice: a FIFO named
+  // .poly is read once and meshed in the same process (before the check the
+  // re-executed process waited on the emptied FIFO forever).
+  const std::string fifo = dir + "/fifo.poly";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] {
+    std::ofstream(fifo) << testing::ReadFileOrFail(cube);
+  });
+  const testing::CommandResult piped =
+      RunSvrc({"mesh", fifo, "--max-volume", "1e-3", "-o", dir + "/piped.node", "--quiet", "--stats", "--deadline",
+               "60s"});
+  writer.join();
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_EQ(flag(piped), 0) << piped.out;
+  EXPECT_EQ(testing::ReadFileOrFail(dir + "/piped.ele"), testing::ReadFileOrFail(dir + "/off.ele"));
   fs::remove_all(dir);
 }
 
