@@ -1,6 +1,7 @@
 #include "core/mesh/quality.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -70,20 +71,31 @@ Distribution Distribution::Of(std::vector<double> values) {
   Distribution d;
   d.count = values.size();
   if (values.empty()) return d;
-  std::sort(values.begin(), values.end());
-  auto rank = [&](double pct) {
-    // Nearest rank: the smallest value with at least pct% of values <= it.
+  // Nearest rank: the smallest value with at least pct% of values <= it, the
+  // element of index ceil(pct/100·n) − 1 of the sorted values. Selected with
+  // nth_element over a shrinking range, rank by rank, instead of a full sort:
+  // the same values (an order statistic does not depend on how it is found),
+  // and linear time (the sort was 9% of a `svrc mesh --stats` run on cube
+  // --max-volume 1e-5, six dihedral angles per tet).
+  auto index = [&](double pct) {
     const double r = std::ceil(pct / 100.0 * static_cast<double>(values.size()));
     const size_t i = r < 1 ? 0 : static_cast<size_t>(r) - 1;
-    return values[std::min(i, values.size() - 1)];
+    return std::min(i, values.size() - 1);
   };
-  d.min = values.front();
-  d.p1 = rank(1);
-  d.p5 = rank(5);
-  d.p50 = rank(50);
-  d.p95 = rank(95);
-  d.p99 = rank(99);
-  d.max = values.back();
+  const std::array<double, 5> pcts{1, 5, 50, 95, 99};
+  std::array<double*, 5> out{&d.p1, &d.p5, &d.p50, &d.p95, &d.p99};
+  auto first = values.begin();
+  for (size_t k = 0; k < pcts.size(); ++k) {
+    const auto nth = values.begin() + static_cast<std::ptrdiff_t>(index(pcts[k]));
+    if (nth >= first) {
+      std::nth_element(first, nth, values.end());
+      first = nth;  // everything before nth is <= it; later ranks lie at or after it
+    }
+    *out[k] = *nth;
+  }
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  d.min = *lo;
+  d.max = *hi;
   return d;
 }
 

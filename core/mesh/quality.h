@@ -32,7 +32,7 @@ TetQuality ComputeTetQuality(const Vec3& a, const Vec3& b, const Vec3& c, const 
 struct Distribution {
   size_t count = 0;
   double min = 0, p1 = 0, p5 = 0, p50 = 0, p95 = 0, p99 = 0, max = 0;
-  // Sorts `values` (taken by value).
+  // Nearest-rank percentiles of `values` (taken by value and reordered).
   static Distribution Of(std::vector<double> values);
 };
 
