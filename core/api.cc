@@ -207,31 +207,23 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
       if (stage != 0 || v.kind != mesh::ViolationKind::kFacetNotCovered || v.ids.empty()) continue;
       const int64_t f = v.ids[0];
       if (f < 0 || static_cast<size_t>(f) >= plc.facets.size()) continue;
-      geom::Vec3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+      geom::Box3 own;  // the facet's box; `grown` by its diagonal
       for (const auto& poly : plc.facets[f].polygons) {
-        for (uint32_t i : poly.vertices) {
-          const geom::Vec3& x = plc.vertices[i];
-          lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
-          hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
-        }
+        for (uint32_t i : poly.vertices) own.Add(plc.vertices[i]);
       }
-      const double grow = geom::Dist(lo, hi);
-      const geom::Vec3 flo = lo, fhi = hi;  // the facet's own box
-      lo = lo - geom::Vec3{grow, grow, grow};
-      hi = hi + geom::Vec3{grow, grow, grow};
+      const double grow = own.Diagonal();
+      const geom::Box3 grown{own.lo - geom::Vec3{grow, grow, grow}, own.hi + geom::Vec3{grow, grow, grow}};
       mesh::TetMesh near = boxed->mesh;
       near.tets.clear();
       near.tet_region.clear();
       near.triangles.clear();
       near.triangle_marker.clear();
       for (size_t t = 0; t < boxed->mesh.tets.size(); ++t) {
-        bool in = false;
-        for (uint32_t q : boxed->mesh.tets[t]) {
-          const geom::Vec3& x = boxed->mesh.positions[q];
-          in = in || (x.x >= lo.x && x.x <= hi.x && x.y >= lo.y && x.y <= hi.y && x.z >= lo.z && x.z <= hi.z);
+        const auto& tet = boxed->mesh.tets[t];
+        if (std::none_of(tet.begin(), tet.end(), [&](uint32_t q) { return grown.Contains(boxed->mesh.positions[q]); })) {
+          continue;
         }
-        if (!in) continue;
-        near.tets.push_back(boxed->mesh.tets[t]);
+        near.tets.push_back(tet);
         if (!boxed->mesh.tet_region.empty()) near.tet_region.push_back(boxed->mesh.tet_region[t]);
       }
       // The mesh's points lying (nearly) on the facet's plane inside its box
@@ -257,10 +249,7 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
         }
         for (size_t q = 0; q < refined.positions.size(); ++q) {
           const geom::Vec3& x = refined.positions[q];
-          if (corner[q] ||
-              !(x.x >= flo.x && x.x <= fhi.x && x.y >= flo.y && x.y <= fhi.y && x.z >= flo.z && x.z <= fhi.z)) {
-            continue;
-          }
+          if (corner[q] || !own.Contains(x)) continue;
           const double h = geom::Dot(x - o, n);
           if (!(std::fabs(h) < 1e-12 * grow)) continue;
           double collar = HUGE_VAL;  // the nearest collar ball's distance over its radius

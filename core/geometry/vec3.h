@@ -63,6 +63,9 @@ struct Box3 {
     hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
   }
   bool Empty() const { return lo.x > hi.x; }
+  bool Contains(Vec3 p) const {  // closed box
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+  }
   Vec3 Center() const { return 0.5 * (lo + hi); }
   double Diagonal() const { return Empty() ? 0.0 : Dist(lo, hi); }
 };

@@ -611,11 +611,7 @@ class Checker {
   // ------------------------------------------------------------ with a PLC
 
   void PrepareFacets() {
-    double scale = 0;
-    for (const Vec3& p : plc_->vertices) {
-      scale = std::max({scale, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    }
-    tol_ = opt_.tolerance_ulps * kEps52 * scale;
+    tol_ = OnFeatureTolerance(plc_->vertices, opt_.tolerance_ulps);
     first_ = FirstOccurrences(plc_->vertices);
     facets_.reserve(plc_->facets.size());
     for (const auto& f : plc_->facets) facets_.push_back(BuildFacet(*plc_, f, first_, tol_));
@@ -2031,6 +2027,12 @@ std::vector<std::array<uint32_t, 2>> ConformitySegments(const plc::Plc& plc) {
     }
   }
   return out;
+}
+
+double OnFeatureTolerance(std::span<const geom::Vec3> points, double tolerance_ulps) {
+  double scale = 0;
+  for (const geom::Vec3& p : points) scale = std::max({scale, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+  return tolerance_ulps * kEps52 * scale;
 }
 
 ConformityReport CheckConformity(const plc::Plc& plc, const TetMesh& mesh,

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -97,6 +98,13 @@ struct ConformityReport {
   // One line per kind with a nonzero count, then the listed violations.
   std::string Summary() const;
 };
+
+// tolerance_ulps · 2^-52 · the largest absolute coordinate of `points`: the
+// distance within which the checker takes a point as on a plane or a line
+// (ConformityOptions::tolerance_ulps). The refiner takes a point of Ω as on a
+// facet's plane within the same distance (RefineOptions::stitch_faces_on_plane).
+double OnFeatureTolerance(std::span<const geom::Vec3> points,
+                          double tolerance_ulps = ConformityOptions{}.tolerance_ulps);
 
 // The segments the checker walks, in the order kBrokenSegment ids refer to:
 // the PLC's free segments, then the in-facet 2-vertex polygons and the edges

@@ -18,6 +18,7 @@
 
 #include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
+#include "core/mesh/conformity.h"
 #include "core/mesh/stats_payload.h"
 #include "core/geometry/predicates.h"
 #include "core/plc/features.h"
@@ -294,19 +295,29 @@ class Refiner {
     out->assign(th.begin(), th.end());
     std::sort(out->begin(), out->end());
   }
+  // The facets containing every point of `pts` (FacetsOfPoint), ascending,
+  // into *fa (*fb is scratch).
+  void CommonFacets(std::span<const PointId> pts, std::vector<uint32_t>* fa, std::vector<uint32_t>* fb) const {
+    FacetsOfPoint(pts[0], fa);
+    for (size_t j = 1; j < pts.size() && !fa->empty(); ++j) {
+      FacetsOfPoint(pts[j], fb);
+      std::erase_if(*fa, [&](uint32_t f) { return !std::binary_search(fb->begin(), fb->end(), f); });
+    }
+  }
+  // Whether the centroid of the triangle a, b, c (facet f's frame) is in f's
+  // region or on its boundary: a triangle with its corners on a non-convex
+  // outline can span a notch or a hole.
+  bool CentroidInRegion(uint32_t f, Vec2 a, Vec2 b, Vec2 c) const {
+    const Vec2 g{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3};
+    return facets_[f].region().Locate(g) != FacetRegion::Where::kOutside;
+  }
   // The facet a triangle of points lies on: the first facet containing its
   // three points whose region contains its centroid, or kNoFacet.
   uint32_t FacetOfTriangle(const std::array<PointId, 3>& k, std::vector<uint32_t>* fa,
                            std::vector<uint32_t>* fb) const {
-    FacetsOfPoint(k[0], fa);
-    for (int j = 1; j < 3 && !fa->empty(); ++j) {
-      FacetsOfPoint(k[j], fb);
-      std::erase_if(*fa, [&](uint32_t f) { return !std::binary_search(fb->begin(), fb->end(), f); });
-    }
+    CommonFacets(k, fa, fb);
     for (uint32_t f : *fa) {
-      const Vec2 a = Uv(f, k[0]), b = Uv(f, k[1]), c = Uv(f, k[2]);
-      const Vec2 g{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3};
-      if (facets_[f].region().Locate(g) != FacetRegion::Where::kOutside) return f;
+      if (CentroidInRegion(f, Uv(f, k[0]), Uv(f, k[1]), Uv(f, k[2]))) return f;
     }
     return kNoFacet;
   }
@@ -566,8 +577,8 @@ class Refiner {
   // Facets (stage (c)).
   std::vector<FacetMesh> facets_;
   std::vector<plc::FacetFrame> frames_;  // normalised frames
-  // The conformity checker's on-plane tolerance in normalised coordinates:
-  // 8 ulps of the PLC's largest input coordinate (docs/conformity.md).
+  // The conformity checker's on-plane tolerance (mesh::OnFeatureTolerance)
+  // in normalised coordinates.
   double on_plane_tol_ = 0;
   uint32_t facet_mesh0_ = 0;             // MeshId of facet 0 (= its FeatureId)
   std::vector<std::vector<uint32_t>> point_facets_;  // per complex point: facets containing it
@@ -804,11 +815,9 @@ absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const 
   // Global ids = SoS priorities: inputs first (in input order), then corners.
   complex_ = &complex;
   {
-    double scale = 0;
-    for (const plc::FeaturePoint& q : complex.points) {
-      scale = std::max({scale, std::fabs(q.p.x), std::fabs(q.p.y), std::fabs(q.p.z)});
-    }
-    on_plane_tol_ = std::ldexp(8 * std::numeric_limits<double>::epsilon() * scale, -norm_.exponent);
+    std::vector<Vec3> input(complex.points.size());
+    for (size_t i = 0; i < input.size(); ++i) input[i] = complex.points[i].p;
+    on_plane_tol_ = std::ldexp(mesh::OnFeatureTolerance(input), -norm_.exponent);
   }
   for (uint32_t i = 0; i < num_input_; ++i) {
     points_.Add(normalised[i], features_.OfPoint(i), kCdInputVertex, options_.collars && complex.points[i].crease);
@@ -2612,6 +2621,7 @@ std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacet
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> out;
+  if (on_plane != nullptr) *on_plane = 0;
   std::vector<uint32_t> fa, fb;
   for (const auto& k : faces) {
     const uint32_t f = FacetOfTriangle({PointId(k[0]), PointId(k[1]), PointId(k[2])}, &fa, &fb);
@@ -2622,16 +2632,13 @@ std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacet
   one_omega.erase(std::unique(one_omega.begin(), one_omega.end()), one_omega.end());
   size_t added = 0;
   for (const auto& k : one_omega) {
-    FacetsOfPoint(PointId(k[0]), &fa);
-    FacetsOfPoint(PointId(k[1]), &fb);
-    std::erase_if(fa, [&](uint32_t f) { return !std::binary_search(fb.begin(), fb.end(), f); });
+    const std::array<PointId, 2> on{PointId(k[0]), PointId(k[1])};
+    CommonFacets(on, &fa, &fb);
     const Vec3& x = points_.Xyz(PointId(k[2]));
     for (uint32_t f : fa) {
       const plc::FacetFrame& fr = frames_[f];
       if (!(std::fabs(geom::Dot(x - fr.origin, fr.normal)) <= on_plane_tol_)) continue;
-      const Vec2 a = Uv(f, PointId(k[0])), b = Uv(f, PointId(k[1])), c = fr.ToPlane(x);
-      const Vec2 g{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3};
-      if (facets_[f].region().Locate(g) == FacetRegion::Where::kOutside) continue;
+      if (!CentroidInRegion(f, Uv(f, on[0]), Uv(f, on[1]), fr.ToPlane(x))) continue;
       std::array<uint32_t, 3> sorted = k;
       std::sort(sorted.begin(), sorted.end());
       out.emplace_back(f, sorted);
