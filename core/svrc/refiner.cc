@@ -182,8 +182,14 @@ class Refiner {
   absl::StatusOr<bool> BreakFlatTets();
   // Per-tet mode, at the end: every kept tet whose smallest dihedral angle
   // is below min_deg has its circumcentre destroyed (as a Skinny tet's);
-  // returns whether any was (§8 item 38).
-  absl::StatusOr<bool> BreakSlivers(double min_deg);
+  // returns whether any was (§8 item 38). `first`: the first of a series of
+  // rounds with only Run() between them; later rounds skip the tets an
+  // earlier one found permanently clear (sliver_clear_).
+  absl::StatusOr<bool> BreakSlivers(double min_deg, bool first);
+  void EndSliverRounds() {
+    sliver_clear_.clear();
+    sliver_clear_.shrink_to_fit();
+  }
  private:
   // A gap ball of segment mesh `seg` whose centre is the midpoint of the piece
   // starting at local vertex u (Encroached₁ of the piece ball, Skinny₁).
@@ -601,6 +607,11 @@ class Refiner {
   util::PodVector<TetLabel> tet_labels_;
   void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
   std::vector<TetLabel> created_labels_;  // scratch
+  // BreakSlivers: per tet slot, Generation + 1 of a tet found clear for good
+  // (not kept, no angle below the bound, or no plain circumcentre: what only
+  // the tet itself decides), so that the next round of a series skips it
+  // while it lives; 0 otherwise. The ball test is not cached (balls die).
+  util::PodVector<uint32_t> sliver_clear_;
   // Collars (stage (d)).
   const plc::FeatureComplex* complex_ = nullptr;
   CollarIndex collars_;
@@ -1218,6 +1229,19 @@ bool Refiner::IsLive(const WorkEvent& e) {
   if (e.type == EventType::kSkinny) return IsBad(v, last_size_);
   return true;
 }
+
+// Adds the seconds of its scope to *sum (a phase's time in RefineStats).
+class AddSeconds {
+ public:
+  explicit AddSeconds(double* sum) : sum_(sum), start_(std::chrono::steady_clock::now()) {}
+  ~AddSeconds() { *sum_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  AddSeconds(const AddSeconds&) = delete;
+  AddSeconds& operator=(const AddSeconds&) = delete;
+
+ private:
+  double* sum_;
+  std::chrono::steady_clock::time_point start_;
+};
 
 absl::Status Refiner::Run() {
   const auto start = std::chrono::steady_clock::now();
@@ -2927,6 +2951,7 @@ absl::Status Refiner::CheckInvariants(bool final) {
 
 absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume,
                                              bool all_vertices) {
+  const AddSeconds timer(&stats_.seconds_labelling);
   const delaunay::Delaunay3& dt = omega_.dt();
   const uint32_t nv = dt.NumVertices();
   std::vector<Vec3> positions(nv);
@@ -3087,7 +3112,8 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   return any;
 }
 
-absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg) {
+absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
+  const AddSeconds timer(&stats_.seconds_breaks);
   const delaunay::Delaunay3& dt = omega_.dt();
   struct Sliver {
     TetId t;
@@ -3101,7 +3127,15 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg) {
   // tet with 6|V| above ℓ³·sin(min_deg) has no angle below min_deg, and the
   // dihedrals (atan2 per edge) are measured only for the others.
   const double sin_min = std::sin(min_deg * M_PI / 180) * (1 + 1e-6);
+  if (first || !options_.reuse_round_work) sliver_clear_.clear();
+  util::GrowExactly(sliver_clear_, dt.TetCapacity(), 0u);
   for (TetId t : dt.FiniteTets()) {
+    uint32_t& clear = sliver_clear_[t.value()];
+    if (clear == dt.Generation(t) + 1) {
+      ++stats_.sliver_scan_reused;
+      continue;
+    }
+    clear = dt.Generation(t) + 1;  // until a test below keeps it
     const TetLabel* lab = LiveLabel(t);
     if (lab == nullptr || !lab->kept) continue;
     std::array<Vec3, 4> x;
@@ -3110,6 +3144,7 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg) {
     if (!(MeasureSliverTet(x[0], x[1], x[2], x[3]).min_dihedral_deg < min_deg)) continue;
     Vec3 cc;
     if (!omega_.PlainCorner(t, &cc)) continue;
+    clear = 0;  // the ball test below may change when balls die
     // Only slivers whose circumcentre would be inserted as is: one inside a
     // lower ball would split that facet triangle or segment piece instead,
     // and such splits next to the features cascade (measured:
@@ -3135,6 +3170,7 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg) {
 }
 
 absl::StatusOr<bool> Refiner::BreakFlatTets() {
+  const AddSeconds timer(&stats_.seconds_breaks);
   const delaunay::Delaunay3& dt = omega_.dt();
   const geom::Box3& cube = omega_.cube();
   auto on_box = [&](const Vec3& p, int axis, int side) { return p[axis] == (side ? cube.hi[axis] : cube.lo[axis]); };
@@ -3155,12 +3191,10 @@ absl::StatusOr<bool> Refiner::BreakFlatTets() {
   std::vector<uint32_t> fa, fb;
   for (TetId t : dt.FiniteTets()) {
     std::array<Vec3, 4> x;
-    std::array<PointId, 4> q;
-    for (int k = 0; k < 4; ++k) {
-      x[k] = dt.Point(dt.TetVertex(t, k));
-      q[k] = omega_.PointOf(dt.TetVertex(t, k));
-    }
+    for (int k = 0; k < 4; ++k) x[k] = dt.Point(dt.TetVertex(t, k));
     if (Volume6(x) > 1e-6 * LongestEdgeCubed(x)) continue;
+    std::array<PointId, 4> q;
+    for (int k = 0; k < 4; ++k) q[k] = omega_.PointOf(dt.TetVertex(t, k));
     bool boxed = false;
     for (int axis = 0; axis < 3 && !boxed; ++axis) {
       for (int side = 0; side < 2 && !boxed; ++side) {
@@ -3576,6 +3610,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.size_rounds", static_cast<double>(size_rounds));
   out->Set("svrc.flat_tets_broken", static_cast<double>(flat_tets_broken));
   out->Set("svrc.slivers_broken", static_cast<double>(slivers_broken));
+  out->Set("svrc.sliver_scan_reused", static_cast<double>(sliver_scan_reused));
   out->Set("svrc.tied_balls", static_cast<double>(tied_balls));
   out->Set("svrc.phantom_corners", static_cast<double>(phantom_corners));
   out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
@@ -3636,6 +3671,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
     out->Set("svrc.max_unbounded_dihedral_deg", stitch.max_unbounded_dihedral_deg);
   }
   out->Set("svrc.seconds_refine", seconds);
+  out->Set("svrc.seconds_labelling", seconds_labelling);
+  out->Set("svrc.seconds_breaks", seconds_breaks);
 }
 
 // The input's exact normalisation (§1) and Ω: a cube of side 3·diam centred
@@ -3801,12 +3838,13 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   }
   // Slivers of the per-tet mode's output (§8 item 38), a few rounds.
   for (int round = 0; tet_quality && options.sliver_break_deg > 0 && round < 4; ++round) {
-    absl::StatusOr<bool> more = refiner.BreakSlivers(options.sliver_break_deg);
+    absl::StatusOr<bool> more = refiner.BreakSlivers(options.sliver_break_deg, /*first=*/round == 0);
     if (!more.ok()) return more.status();
     if (!*more) break;
     s = refiner.Run();
     if (!s.ok()) return s;
   }
+  refiner.EndSliverRounds();
   int crossing_passes = 0, size_passes = 0, stitch_repair_passes = 0;
   for (int stitch_pass = 0;; ++stitch_pass) {
   if (options.collars && options.collar_surface) {

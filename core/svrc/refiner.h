@@ -123,7 +123,8 @@ struct RefineOptions {
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
-  // EnqueueMissing found in M_Ω. false: everything recomputed every round,
+  // EnqueueMissing found in M_Ω; and in the rounds of BreakSlivers, the tets
+  // an earlier round found clear for good. false: everything recomputed every round,
   // the reference the reuse must reproduce bit for bit (tests).
   bool reuse_round_work = true;
   // When the COLLAR rounds run their facet-crossing check (a T′ edge
@@ -303,6 +304,7 @@ struct RefineStats {
   uint64_t stitched_crossings = 0;      // all points for stitched tets crossing a facet (arc points included)
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   uint64_t slivers_broken = 0;     // kept slivers broken by an insertion at the end (per-tet mode)
+  uint64_t sliver_scan_reused = 0; // tets a later BreakSlivers round skipped: an earlier one found them clear
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
@@ -330,7 +332,9 @@ struct RefineStats {
   uint64_t predicate_exact = 0;    // filter failures → exact arithmetic
   uint64_t predicate_sos = 0;      // exact zero → symbolic perturbation
   double max_aspect = 0;           // max R_v/r_v over cells at the end (0 under tet_quality)
-  double seconds = 0;
+  double seconds = 0;              // in Run(): the queues' work
+  double seconds_labelling = 0;    // labelling M_Ω for size targets (SetSizeTargets)
+  double seconds_breaks = 0;       // the scans of BreakFlatTets and BreakSlivers (their insertions: Run())
 
   // Appends the counters to a MeshStats (names "svrc.*").
   void ExportTo(mesh::MeshStats* out) const;

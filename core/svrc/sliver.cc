@@ -215,13 +215,17 @@ class FlipMesh {
   Reject NewTet(const Tet& t, double re_bound, double volume_bound, Quality* q) const;
   // The 2-3 flip across face f of t, and the best removal of the edge
   // (v[i], v[j]) of t. False when the flip is illegal (constraint, orientation,
-  // bounds); otherwise new_min/old_min are filled.
+  // bounds); otherwise new_min/old_min are filled. The edge removal may also
+  // return false when its best new_min would be <= floor (or <= its old_min,
+  // with above_old): the caller rejects those, and the triangles that cannot
+  // be part of any other triangulation are not measured in full.
   bool Build23(uint32_t t, int f, Flip* flip);
-  bool BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip);
+  bool BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool above_old, Flip* flip);
   // Every legal flip replacing t (2-3 across its faces, removal of its edges),
-  // in a fixed order.
+  // in a fixed order; those the caller rejects for new_min <= floor (or <=
+  // old_min, with above_old) may be left out.
   template <typename Fn>
-  void ForEachFlip(uint32_t t, Fn&& fn);
+  void ForEachFlip(uint32_t t, double floor, bool above_old, Fn&& fn);
   // The legal flip replacing t with the largest new_min, among those with
   // new_min > max(floor, their own old_min). False if none.
   bool BestFlip(uint32_t t, double floor, Flip* best);
@@ -592,7 +596,7 @@ bool FlipMesh::Build23(uint32_t t, int f, Flip* flip) {
   return true;
 }
 
-bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
+bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool above_old, Flip* flip) {
   const uint32_t p = tet_[t][i], q = tet_[t][j];
   std::array<uint32_t, kMaxRing> ring_tets{}, u{};
   int n = 0;
@@ -611,6 +615,12 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
     re_bound = std::max(re_bound, quality_[ring_tets[k]].radius_edge);
   }
   const double volume_bound = component_max_volume_[component_[t]];
+  // A triangle whose tets' worst angle is <= prune can be in no triangulation
+  // the caller accepts. Leaving it out (−∞) changes no value above prune in
+  // the program below, nor which split attains it (ties: the smallest c), so
+  // an accepted flip comes out the same; its second tet's angles are then
+  // not measured once the first's are <= prune.
+  const double prune = above_old ? std::max(floor, old_min) : floor;
   // The ring's oriented boundary is +[q, u_k, u_k+1] and −[p, u_k, u_k+1].
   // For a triangulation of the ring polygon u_0..u_{n-1} (triangles in ring
   // order), the tets (a, b, c, q) and (b, a, c, p) over its triangles have the
@@ -621,6 +631,7 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
   double tri[kMaxRing][kMaxRing][kMaxRing];
   Quality tri_q[kMaxRingTris][2];
   int worst_reject = kOk;
+  bool pruned = false;
   for (int a = 0; a < n; ++a) {
     for (int c = a + 1; c < n; ++c) {
       for (int b = c + 1; b < n; ++b) {
@@ -634,6 +645,10 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
           continue;
         }
         FillDihedrals(pos_, up, &tq[0]);
+        if (!(tq[0].min_dihedral > prune)) {
+          pruned = true;
+          continue;
+        }
         FillDihedrals(pos_, down, &tq[1]);
         tri[a][c][b] = std::min(tq[0].min_dihedral, tq[1].min_dihedral);
       }
@@ -661,7 +676,11 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
     }
   }
   if (!(best[0][n - 1] > -kInf)) {
-    CountReject(worst_reject == kOk ? kOrientation : worst_reject, stats_);
+    if (worst_reject == kOk && pruned) {
+      ++stats_->rejected_no_gain;
+    } else {
+      CountReject(worst_reject == kOk ? kOrientation : worst_reject, stats_);
+    }
     return false;
   }
   flip->ring = n;
@@ -692,7 +711,7 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, Flip* flip) {
 }
 
 template <typename Fn>
-void FlipMesh::ForEachFlip(uint32_t t, Fn&& fn) {
+void FlipMesh::ForEachFlip(uint32_t t, double floor, bool above_old, Fn&& fn) {
   for (int f = 0; f < 4; ++f) {
     Flip flip;
     if (Build23(t, f, &flip)) fn(flip);
@@ -700,7 +719,7 @@ void FlipMesh::ForEachFlip(uint32_t t, Fn&& fn) {
   static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   for (const auto& ij : kEdges) {
     Flip flip;
-    if (BuildEdgeRemoval(t, ij[0], ij[1], &flip)) fn(flip);
+    if (BuildEdgeRemoval(t, ij[0], ij[1], floor, above_old, &flip)) fn(flip);
   }
 }
 
@@ -726,7 +745,7 @@ bool FlipMesh::RaisesCreaseAngle(const Flip& f) const {
 
 bool FlipMesh::BestFlip(uint32_t t, double floor, Flip* best) {
   bool found = false;
-  ForEachFlip(t, [&](const Flip& f) {
+  ForEachFlip(t, floor, /*above_old=*/true, [&](const Flip& f) {
     if (!(f.new_min > f.old_min) || !(f.new_min > floor)) {
       ++stats_->rejected_no_gain;
       return;
@@ -857,7 +876,7 @@ bool FlipMesh::Search(uint32_t t, int depth, double floor, std::vector<Flip>* se
   std::vector<Flip> rest;
   std::vector<uint32_t> scratch;
   for (uint32_t s : near) {
-    ForEachFlip(s, [&](const Flip& f1) {
+    ForEachFlip(s, floor, /*above_old=*/false, [&](const Flip& f1) {
       if (f1.Replaces(t) || !(f1.new_min > floor)) return;
       if (found && !(f1.new_min > *score)) return;  // cannot beat the best sequence
       Journal journal;

@@ -840,9 +840,10 @@ TEST(CollarRefine, SliverPassSkipsTheExteriorWithTheSameOutput) {
 // RefineOptions::reuse_round_work: the COLLAR rounds' per-ball restricted
 // Delaunay of S, the settled facets' arc checks and EnqueueMissing's memory
 // of simplices found in M_Ω must give the refinement of a run that
-// recomputes them every round, bit for bit. knife_edge.poly and
+// recomputes them every round, bit for bit; so must BreakSlivers' rounds
+// that skip the tets an earlier round found clear. knife_edge.poly and
 // segment_fan.poly run many COLLAR rounds; cube.poly with max_volume runs
-// size rounds (each ends in EnqueueMissing).
+// size rounds (each ends in EnqueueMissing) and sliver rounds.
 TEST(CollarRefine, ReusedRoundWorkGivesTheSameRefinement) {
   if (kSanitized) GTEST_SKIP() << "release only";
   for (const SameRefinementCase& c :
@@ -851,9 +852,13 @@ TEST(CollarRefine, ReusedRoundWorkGivesTheSameRefinement) {
     const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->reuse_round_work = on; });
     EXPECT_EQ(runs[0].stats.collar_balls_reused, 0u) << c.rel;
     EXPECT_EQ(runs[0].stats.arc_facets_settled, 0u) << c.rel;
+    EXPECT_EQ(runs[0].stats.sliver_scan_reused, 0u) << c.rel;
     if (c.collars) {
       EXPECT_GT(runs[1].stats.collar_balls_reused, 0u) << c.rel;
       EXPECT_GT(runs[1].stats.collar_rounds, 3u) << c.rel;
+    } else {
+      // BreakSlivers' later rounds skip the tets an earlier one cleared.
+      EXPECT_GT(runs[1].stats.sliver_scan_reused, 0u) << c.rel;
     }
   }
 }
