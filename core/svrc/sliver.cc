@@ -222,10 +222,12 @@ class FlipMesh {
   bool Build23(uint32_t t, int f, Flip* flip);
   bool BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool above_old, Flip* flip);
   // Every legal flip replacing t (2-3 across its faces, removal of its edges),
-  // in a fixed order; those the caller rejects for new_min <= floor (or <=
-  // old_min, with above_old) may be left out.
-  template <typename Fn>
-  void ForEachFlip(uint32_t t, double floor, bool above_old, Fn&& fn);
+  // in a fixed order; edge removals the caller rejects for new_min <= floor()
+  // (or <= their old_min, with above_old) may be left out. floor() is read
+  // before each edge removal: a caller that keeps the best flip so far raises
+  // it as it goes.
+  template <typename Floor, typename Fn>
+  void ForEachFlip(uint32_t t, bool above_old, Floor&& floor, Fn&& fn);
   // The legal flip replacing t with the largest new_min, among those with
   // new_min > max(floor, their own old_min). False if none.
   bool BestFlip(uint32_t t, double floor, Flip* best);
@@ -620,7 +622,8 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
   // the program below, nor which split attains it (ties: the smallest c), so
   // an accepted flip comes out the same; its second tet's angles are then
   // not measured once the first's are <= prune.
-  const double prune = above_old ? std::max(floor, old_min) : floor;
+  const double prune =
+      !options_.prune_edge_removals ? -kInf : above_old ? std::max(floor, old_min) : floor;
   // The ring's oriented boundary is +[q, u_k, u_k+1] and −[p, u_k, u_k+1].
   // For a triangulation of the ring polygon u_0..u_{n-1} (triangles in ring
   // order), the tets (a, b, c, q) and (b, a, c, p) over its triangles have the
@@ -647,6 +650,7 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
         FillDihedrals(pos_, up, &tq[0]);
         if (!(tq[0].min_dihedral > prune)) {
           pruned = true;
+          ++stats_->pruned_triangles;
           continue;
         }
         FillDihedrals(pos_, down, &tq[1]);
@@ -710,8 +714,8 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
   return true;
 }
 
-template <typename Fn>
-void FlipMesh::ForEachFlip(uint32_t t, double floor, bool above_old, Fn&& fn) {
+template <typename Floor, typename Fn>
+void FlipMesh::ForEachFlip(uint32_t t, bool above_old, Floor&& floor, Fn&& fn) {
   for (int f = 0; f < 4; ++f) {
     Flip flip;
     if (Build23(t, f, &flip)) fn(flip);
@@ -719,7 +723,7 @@ void FlipMesh::ForEachFlip(uint32_t t, double floor, bool above_old, Fn&& fn) {
   static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   for (const auto& ij : kEdges) {
     Flip flip;
-    if (BuildEdgeRemoval(t, ij[0], ij[1], floor, above_old, &flip)) fn(flip);
+    if (BuildEdgeRemoval(t, ij[0], ij[1], floor(), above_old, &flip)) fn(flip);
   }
 }
 
@@ -745,7 +749,9 @@ bool FlipMesh::RaisesCreaseAngle(const Flip& f) const {
 
 bool FlipMesh::BestFlip(uint32_t t, double floor, Flip* best) {
   bool found = false;
-  ForEachFlip(t, floor, /*above_old=*/true, [&](const Flip& f) {
+  // A flip is taken only above floor, its old_min and the best so far.
+  auto prune = [&] { return found ? std::max(floor, best->new_min) : floor; };
+  ForEachFlip(t, /*above_old=*/true, prune, [&](const Flip& f) {
     if (!(f.new_min > f.old_min) || !(f.new_min > floor)) {
       ++stats_->rejected_no_gain;
       return;
@@ -876,7 +882,9 @@ bool FlipMesh::Search(uint32_t t, int depth, double floor, std::vector<Flip>* se
   std::vector<Flip> rest;
   std::vector<uint32_t> scratch;
   for (uint32_t s : near) {
-    ForEachFlip(s, floor, /*above_old=*/false, [&](const Flip& f1) {
+    // F1 is taken only above floor and, once a sequence is found, its score.
+    auto prune = [&] { return found ? std::max(floor, *score) : floor; };
+    ForEachFlip(s, /*above_old=*/false, prune, [&](const Flip& f1) {
       if (f1.Replaces(t) || !(f1.new_min > floor)) return;
       if (found && !(f1.new_min > *score)) return;  // cannot beat the best sequence
       Journal journal;
@@ -1104,6 +1112,7 @@ void SliverStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("sliver.lookahead_sequences", static_cast<double>(lookahead_sequences));
   out->Set("sliver.passes", static_cast<double>(passes));
   out->Set("sliver.candidates", static_cast<double>(candidates));
+  out->Set("sliver.pruned_triangles", static_cast<double>(pruned_triangles));
   out->Set("sliver.rejected_orientation", static_cast<double>(rejected_orientation));
   out->Set("sliver.rejected_constraint", static_cast<double>(rejected_constraint));
   out->Set("sliver.rejected_radius_edge", static_cast<double>(rejected_radius_edge));

@@ -433,6 +433,60 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
   EXPECT_GT(sequences, 0u);  // the depth-2 search was exercised (and kept every invariant above)
 }
 
+// SliverOptions::prune_edge_removals: an edge removal leaves out the ring
+// triangles whose first tet is no better than the flip it must beat (the
+// caller's floor, the ring's old worst, the best flip so far). The dynamic
+// program then picks the same triangulation whenever the caller could accept
+// it, so the pass must make the same flips, bit for bit, as with every
+// triangle measured — single flips and the depth-2 search alike. Random
+// Delaunay meshes with a jittered grid (near-cospherical groups: slivers),
+// a 15° target so that many tets are bad, no radius-edge bound to block them.
+TEST(Sliver, PrunedEdgeRemovalsMakeTheSameFlips) {
+  uint64_t pruned = 0, sequences = 0, removals = 0;
+  for (uint64_t seed : {4u, 5u, 6u}) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<Vec3> pos;
+    for (int i = 0; i < 150; ++i) pos.push_back({u(rng), u(rng), u(rng)});
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) {
+        for (int k = 0; k < 3; ++k) {
+          pos.push_back({0.1 + 0.15 * i + 1e-3 * u(rng), 0.1 + 0.15 * j + 1e-3 * u(rng), 1.2 + 0.15 * k + 1e-3 * u(rng)});
+        }
+      }
+    }
+    absl::StatusOr<delaunay::PointSetResult> del = delaunay::TetrahedralizePointSet(pos);
+    ASSERT_TRUE(del.ok()) << del.status();
+    std::vector<SliverResult> runs;
+    for (bool prune : {false, true}) {
+      SliverOptions opt;
+      opt.target_min_dihedral_deg = 15;
+      opt.max_radius_edge = 3;
+      opt.prune_edge_removals = prune;
+      absl::StatusOr<SliverResult> r = RemoveSlivers(SliverInput{pos, del->tets, {}, {}}, opt);
+      ASSERT_TRUE(r.ok()) << r.status();
+      runs.push_back(std::move(*r));
+    }
+    const SliverStats& a = runs[0].stats;
+    const SliverStats& b = runs[1].stats;
+    EXPECT_EQ(runs[0].tets, runs[1].tets) << "seed " << seed;
+    EXPECT_EQ(a.flips_23, b.flips_23) << "seed " << seed;
+    EXPECT_EQ(a.flips_32, b.flips_32) << "seed " << seed;
+    EXPECT_EQ(a.flips_44, b.flips_44) << "seed " << seed;
+    EXPECT_EQ(a.flips_edge_removal, b.flips_edge_removal) << "seed " << seed;
+    EXPECT_EQ(a.lookahead_sequences, b.lookahead_sequences) << "seed " << seed;
+    EXPECT_EQ(a.min_dihedral_after, b.min_dihedral_after) << "seed " << seed;
+    EXPECT_EQ(a.pruned_triangles, 0u);
+    EXPECT_GT(a.flips(), 0u) << "seed " << seed;
+    pruned += b.pruned_triangles;
+    sequences += b.lookahead_sequences;
+    removals += b.flips_32 + b.flips_44 + b.flips_edge_removal;
+  }
+  EXPECT_GT(pruned, 0u);     // the pruning ran
+  EXPECT_GT(removals, 0u);   // and edge removals were taken with it
+  EXPECT_GT(sequences, 0u);  // the depth-2 search too
+}
+
 // The pass measures an input tet's dihedral angles only when its volume
 // does not already place them all between the target and 180° − target.
 // Its "before" statistics must still be those of every tet: checked against
