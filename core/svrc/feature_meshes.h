@@ -50,11 +50,17 @@ struct CellSize {
 struct TetLabel {
   uint32_t gen = 0;
   bool kept = false;  // next to gen: 24 bytes, not 32 (one per tet slot)
+  // Refiner::BreakSlivers: a round found this tet clear for good (not kept,
+  // no angle below the bound, no plain circumcentre: what the tet alone
+  // decides), so the next round of the series skips it. False in every label
+  // written for a new tet.
+  bool sliver_clear = false;
   double target = HUGE_VAL;
   // Its region's max_volume in normalised coordinates (+inf: none); read by
   // the per-tet volume test (RefineOptions::tet_volumes).
   double volume = HUGE_VAL;
 };
+static_assert(sizeof(TetLabel) == 24);  // one per M_Ω tet slot
 
 class OmegaMesh {
  public:

@@ -184,12 +184,8 @@ class Refiner {
   // is below min_deg has its circumcentre destroyed (as a Skinny tet's);
   // returns whether any was (§8 item 38). `first`: the first of a series of
   // rounds with only Run() between them; later rounds skip the tets an
-  // earlier one found permanently clear (sliver_clear_).
+  // earlier one found clear for good (TetLabel::sliver_clear).
   absl::StatusOr<bool> BreakSlivers(double min_deg, bool first);
-  void EndSliverRounds() {
-    sliver_clear_.clear();
-    sliver_clear_.shrink_to_fit();
-  }
  private:
   // A gap ball of segment mesh `seg` whose centre is the midpoint of the piece
   // starting at local vertex u (Encroached₁ of the piece ball, Skinny₁).
@@ -607,11 +603,6 @@ class Refiner {
   util::PodVector<TetLabel> tet_labels_;
   void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
   std::vector<TetLabel> created_labels_;  // scratch
-  // BreakSlivers: per tet slot, Generation + 1 of a tet found clear for good
-  // (not kept, no angle below the bound, or no plain circumcentre: what only
-  // the tet itself decides), so that the next round of a series skips it
-  // while it lives; 0 otherwise. The ball test is not cached (balls die).
-  util::PodVector<uint32_t> sliver_clear_;
   // Collars (stage (d)).
   const plc::FeatureComplex* complex_ = nullptr;
   CollarIndex collars_;
@@ -1878,8 +1869,8 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
     const TetId c = inserted.created[k];
     const bool known = created_labels_[k].gen != 0;
     const double target = created_labels_[k].target;
-    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, created_labels_[k].kept, target,
-                              created_labels_[k].volume};
+    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, created_labels_[k].kept,
+                              /*sliver_clear=*/false, target, created_labels_[k].volume};
     if (!known || target == HUGE_VAL || dt.IsGhost(c) || tet_sizes_) continue;
     for (int i = 0; i < 4; ++i) {
       const uint32_t v = dt.TetVertex(c, i).value();
@@ -3080,7 +3071,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
     if (!tet_labels_.empty()) {
-      tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, lab->Kept(static_cast<uint32_t>(t)), HUGE_VAL};
+      tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, lab->Kept(static_cast<uint32_t>(t)), false, HUGE_VAL};
     }
     if (!lab->Kept(static_cast<uint32_t>(t))) continue;
     if (tet_volume[t] == HUGE_VAL) continue;
@@ -3127,24 +3118,26 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
   // tet with 6|V| above ℓ³·sin(min_deg) has no angle below min_deg, and the
   // dihedrals (atan2 per edge) are measured only for the others.
   const double sin_min = std::sin(min_deg * M_PI / 180) * (1 + 1e-6);
-  if (first || !options_.reuse_round_work) sliver_clear_.clear();
-  util::GrowExactly(sliver_clear_, dt.TetCapacity(), 0u);
+  const bool reuse = !first && options_.reuse_round_work;
   for (TetId t : dt.FiniteTets()) {
-    uint32_t& clear = sliver_clear_[t.value()];
-    if (clear == dt.Generation(t) + 1) {
+    const TetLabel* lab = LiveLabel(t);
+    if (lab == nullptr) continue;
+    // TetLabel::sliver_clear: set below on every live label a round reads,
+    // so the first round leaves none stale; new tets' labels start clear of it.
+    bool& clear = tet_labels_[t.value()].sliver_clear;
+    if (reuse && clear) {
       ++stats_.sliver_scan_reused;
       continue;
     }
-    clear = dt.Generation(t) + 1;  // until a test below keeps it
-    const TetLabel* lab = LiveLabel(t);
-    if (lab == nullptr || !lab->kept) continue;
+    clear = true;  // until a test below keeps it
+    if (!lab->kept) continue;
     std::array<Vec3, 4> x;
     for (int k = 0; k < 4; ++k) x[k] = dt.Point(dt.TetVertex(t, k));
     if (Volume6(x) > LongestEdgeCubed(x) * sin_min) continue;
     if (!(MeasureSliverTet(x[0], x[1], x[2], x[3]).min_dihedral_deg < min_deg)) continue;
     Vec3 cc;
     if (!omega_.PlainCorner(t, &cc)) continue;
-    clear = 0;  // the ball test below may change when balls die
+    clear = false;  // the ball test below may change when balls die
     // Only slivers whose circumcentre would be inserted as is: one inside a
     // lower ball would split that facet triangle or segment piece instead,
     // and such splits next to the features cascade (measured:
@@ -3844,7 +3837,6 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
     s = refiner.Run();
     if (!s.ok()) return s;
   }
-  refiner.EndSliverRounds();
   int crossing_passes = 0, size_passes = 0, stitch_repair_passes = 0;
   for (int stitch_pass = 0;; ++stitch_pass) {
   if (options.collars && options.collar_surface) {
