@@ -631,36 +631,53 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
   // exactly their union. Best triangulation (largest worst quality) by
   // dynamic programming over polygon intervals (Shewchuk 2002, Klincsek 1980):
   // best[a][b] = max over a < c < b of min(best[a][c], best[c][b], tri(a, c, b)).
-  double tri[kMaxRing][kMaxRing][kMaxRing];
+  // Triangles are measured on demand (tri), each at most once: first those on
+  // the edge u_0 u_{n-1}, one of which every triangulation holds (none valid:
+  // no flip, the common case), then only where the program below could use
+  // the value: min(best[a][c], best[c][b]) above both the interval's best so
+  // far and prune (otherwise the candidate loses whatever the triangle is).
   Quality tri_q[kMaxRingTris][2];
+  double tri_v[kMaxRingTris];
+  uint64_t tri_done = 0;  // bit kRingTri[a][c][b]: tri_v measured
+  static_assert(kMaxRingTris <= 64);
   int worst_reject = kOk;
   bool pruned = false;
-  for (int a = 0; a < n; ++a) {
-    for (int c = a + 1; c < n; ++c) {
-      for (int b = c + 1; b < n; ++b) {
-        tri[a][c][b] = -kInf;
-        const Tet up{u[a], u[c], u[b], q}, down{u[c], u[a], u[b], p};
-        Quality* tq = tri_q[kRingTri[a][c][b]];
-        const Reject r1 = NewTet(up, re_bound, volume_bound, &tq[0]);
-        const Reject r2 = r1 == kOk ? NewTet(down, re_bound, volume_bound, &tq[1]) : kOk;
-        if (r1 != kOk || r2 != kOk) {
-          worst_reject = std::max(worst_reject, static_cast<int>(r1 != kOk ? r1 : r2));
-          continue;
-        }
-        FillDihedrals(pos_, up, &tq[0]);
-        if (!(tq[0].min_dihedral > prune)) {
-          pruned = true;
-          ++stats_->pruned_triangles;
-          continue;
-        }
-        FillDihedrals(pos_, down, &tq[1]);
-        tri[a][c][b] = std::min(tq[0].min_dihedral, tq[1].min_dihedral);
+  auto tri = [&](int a, int c, int b) -> double {
+    const int k = kRingTri[a][c][b];
+    if ((tri_done >> k) & 1) return tri_v[k];
+    tri_done |= uint64_t{1} << k;
+    tri_v[k] = -kInf;
+    const Tet up{u[a], u[c], u[b], q}, down{u[c], u[a], u[b], p};
+    Quality* tq = tri_q[k];
+    const Reject r1 = NewTet(up, re_bound, volume_bound, &tq[0]);
+    const Reject r2 = r1 == kOk ? NewTet(down, re_bound, volume_bound, &tq[1]) : kOk;
+    if (r1 != kOk || r2 != kOk) {
+      worst_reject = std::max(worst_reject, static_cast<int>(r1 != kOk ? r1 : r2));
+      return tri_v[k];
+    }
+    FillDihedrals(pos_, up, &tq[0]);
+    if (!(tq[0].min_dihedral > prune)) {
+      pruned = true;
+      ++stats_->pruned_triangles;
+      return tri_v[k];
+    }
+    FillDihedrals(pos_, down, &tq[1]);
+    tri_v[k] = std::min(tq[0].min_dihedral, tq[1].min_dihedral);
+    return tri_v[k];
+  };
+  if (!options_.prune_edge_removals) {  // the reference: every triangle measured
+    for (int a = 0; a < n; ++a) {
+      for (int c = a + 1; c < n; ++c) {
+        for (int b = c + 1; b < n; ++b) tri(a, c, b);
       }
     }
   }
+  bool base = false;
+  for (int c = 1; c + 1 < n && !base; ++c) base = tri(0, c, n - 1) > -kInf;
   double best[kMaxRing][kMaxRing];
   int arg[kMaxRing][kMaxRing];
-  for (int len = 1; len < n; ++len) {
+  best[0][n - 1] = -kInf;
+  for (int len = 1; len < n && base; ++len) {
     for (int a = 0; a + len < n; ++a) {
       const int b = a + len;
       if (len == 1) {
@@ -671,7 +688,9 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
       best[a][b] = -kInf;
       arg[a][b] = -1;
       for (int c = a + 1; c < b; ++c) {
-        const double v = std::min(std::min(best[a][c], best[c][b]), tri[a][c][b]);
+        const double sub = std::min(best[a][c], best[c][b]);
+        if (!(sub > std::max(best[a][b], prune))) continue;
+        const double v = std::min(sub, tri(a, c, b));
         if (v > best[a][b]) {  // ties: the smallest c
           best[a][b] = v;
           arg[a][b] = c;
@@ -703,7 +722,7 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
     const int c = arg[a][b];
     if (c < 0) continue;
     flip->new_tets[flip->num_new] = {u[a], u[c], u[b], q};
-    flip->new_quality[flip->num_new++] = tri_q[kRingTri[a][c][b]][0];
+    flip->new_quality[flip->num_new++] = tri_q[kRingTri[a][c][b]][0];  // measured: c = arg[a][b]
     flip->new_tets[flip->num_new] = {u[c], u[a], u[b], p};
     flip->new_quality[flip->num_new++] = tri_q[kRingTri[a][c][b]][1];
     stack[top][0] = a;
