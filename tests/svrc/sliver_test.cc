@@ -349,6 +349,23 @@ TEST(Sliver, PipelineFormTakesChainsAsEdges) {
   EXPECT_EQ(r->stats.flips_32, 1u);
 }
 
+// `random` uniform points in the unit cube and, above it, a jittered 6×6×3
+// grid layer: near-cospherical groups make Delaunay slivers.
+std::vector<Vec3> RandomPointsAndJitteredGrid(uint64_t seed, int random) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> pos;
+  for (int i = 0; i < random; ++i) pos.push_back({u(rng), u(rng), u(rng)});
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      for (int k = 0; k < 3; ++k) {
+        pos.push_back({0.1 + 0.15 * i + 1e-3 * u(rng), 0.1 + 0.15 * j + 1e-3 * u(rng), 1.2 + 0.15 * k + 1e-3 * u(rng)});
+      }
+    }
+  }
+  return pos;
+}
+
 // Random Delaunay meshes (core/delaunay/point_set.h: 200 uniform points and a
 // jittered grid, ~1900 tets), with every 5th interior face and every 7th edge
 // constrained: after the pass the tets are a proper
@@ -358,18 +375,7 @@ TEST(Sliver, PipelineFormTakesChainsAsEdges) {
 TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
   uint64_t sequences = 0;
   for (uint64_t seed : {1u, 2u, 3u}) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0, 1);
-    std::vector<Vec3> pos;
-    for (int i = 0; i < 200; ++i) pos.push_back({u(rng), u(rng), u(rng)});
-    // A jittered grid layer: near-cospherical groups make Delaunay slivers.
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) {
-        for (int k = 0; k < 3; ++k) {
-          pos.push_back({0.1 + 0.15 * i + 1e-3 * u(rng), 0.1 + 0.15 * j + 1e-3 * u(rng), 1.2 + 0.15 * k + 1e-3 * u(rng)});
-        }
-      }
-    }
+    const std::vector<Vec3> pos = RandomPointsAndJitteredGrid(seed, 200);
     absl::StatusOr<delaunay::PointSetResult> del = delaunay::TetrahedralizePointSet(pos);
     ASSERT_TRUE(del.ok()) << del.status();
     const std::vector<Tet> tets = del->tets;
@@ -444,17 +450,7 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
 TEST(Sliver, PrunedEdgeRemovalsMakeTheSameFlips) {
   uint64_t pruned = 0, sequences = 0, removals = 0;
   for (uint64_t seed : {4u, 5u, 6u}) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0, 1);
-    std::vector<Vec3> pos;
-    for (int i = 0; i < 150; ++i) pos.push_back({u(rng), u(rng), u(rng)});
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) {
-        for (int k = 0; k < 3; ++k) {
-          pos.push_back({0.1 + 0.15 * i + 1e-3 * u(rng), 0.1 + 0.15 * j + 1e-3 * u(rng), 1.2 + 0.15 * k + 1e-3 * u(rng)});
-        }
-      }
-    }
+    const std::vector<Vec3> pos = RandomPointsAndJitteredGrid(seed, 150);
     absl::StatusOr<delaunay::PointSetResult> del = delaunay::TetrahedralizePointSet(pos);
     ASSERT_TRUE(del.ok()) << del.status();
     std::vector<SliverResult> runs;
