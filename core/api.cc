@@ -162,17 +162,15 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
 
 }  // namespace
 
-bool ExpectLongRun(const plc::Plc& plc, const MeshParams& params) {
-  if (params.max_volume > 0) return true;
-  for (const plc::RegionSeed& r : plc.regions) {
-    if (r.max_volume > 0) return true;
-  }
-  if (plc.vertices.size() >= 1000) return true;
-  if (plc.segments.empty() && plc.facets.empty()) return false;
+bool HugePageHeapPays(const plc::Plc& plc, const MeshParams& params) {
+  bool long_run = params.max_volume > 0 || plc.vertices.size() >= 1000;
+  for (const plc::RegionSeed& r : plc.regions) long_run = long_run || r.max_volume > 0;
+  if (!long_run) return false;
+  if (plc.segments.empty() && plc.facets.empty()) return true;  // a point set: no creases
   absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(plc, {}, {}, nullptr);
   if (!complex.ok()) return false;
   double sharpest = 90;
-  return !FirstCrease(*complex, &sharpest).empty() && sharpest < kCollarAngleDeg;
+  return FirstCrease(*complex, &sharpest).empty() || sharpest >= kCollarAngleDeg;
 }
 
 namespace {

@@ -91,13 +91,16 @@ absl::StatusOr<mesh::TetMesh> MeshPlc(const plc::Plc& plc, const MeshParams& par
                                       const ProgressCallback& progress = nullptr,
                                       const CancelToken* cancel = nullptr);
 
-// Whether meshing `plc` with `params` is likely to take more than a second and
-// hundreds of MB: a max_volume (global or per region), 1,000 or more input
-// vertices, or a crease below 45 degrees (the collar path). The CLI re-executes
-// itself with a huge-page heap for such jobs only (core/util/huge_pages.h): the
-// second start-up costs about as much as a small job. A guess, not a bound;
-// false for an input PreparePlc refuses.
-bool ExpectLongRun(const plc::Plc& plc, const MeshParams& params);
+// Whether meshing `plc` with `params` gains from a heap on transparent huge
+// pages (core/util/huge_pages.h; docs/svrc-design.md §8 item 49): a job likely
+// to take more than a second and hundreds of MB (a max_volume, global or per
+// region, or 1,000 or more input vertices) that does not take the collar path
+// (no crease below 45 degrees). The CLI re-executes itself for such jobs only:
+// for a small job the second start-up costs about as much as the job, and
+// collar jobs ran 1.3-1.8x slower on the huge-page heap (session 24: bunny.off,
+// two facets at 0.1 degrees), where cube.poly --max-volume 1e-6 ran 10-15%
+// faster. A guess, not a bound; false for an input PreparePlc refuses.
+bool HugePageHeapPays(const plc::Plc& plc, const MeshParams& params);
 
 // "svrc <major>.<minor>.<patch>", for provenance in every result.
 std::string Version();

@@ -5,7 +5,9 @@
 #include <signal.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/strings/numbers.h"
@@ -46,9 +48,13 @@ int Usage(const std::string& why) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The workers' heaps on transparent huge pages (core/util/huge_pages.h).
+  // The workers' heaps on transparent huge pages only when the operator asks
+  // (SVRC_HUGE_PAGES=1; core/util/huge_pages.h): one heap serves every job,
+  // and collar jobs ran 1.3-1.8x slower on it (docs/svrc-design.md §8 item 49).
   // Returns only if it did not re-execute.
-  svrc::util::ReexecWithHugePageHeap(argv);
+  if (const char* hp = std::getenv("SVRC_HUGE_PAGES"); hp != nullptr && std::string_view(hp) == "1") {
+    svrc::util::ReexecWithHugePageHeap(argv);
+  }
   using svrc::server::ServerOptions;
   ServerOptions options;
   for (int i = 1; i < argc; ++i) {
