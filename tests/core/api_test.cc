@@ -85,7 +85,7 @@ TEST(HugePageHeapPaysTest, LongJobsWithoutCollars) {
   EXPECT_TRUE(HugePageHeapPays(read("b_internal/example.poly"), params));
   const plc::Plc knife = read("c_creases/knife_edge.poly");
   EXPECT_FALSE(HugePageHeapPays(knife, params));                       // collars, small
-  EXPECT_FALSE(HugePageHeapPays(read("f_real/bunny.off"), params));  // 34,834 points, collars
+  EXPECT_FALSE(HugePageHeapPays(read("f_real/bunny.off"), params));  // 3,485 points, collars
   plc::Plc regional = cube;
   regional.regions.push_back({{0.5, 0.5, 0.5}, 1, 1e-3});
   EXPECT_TRUE(HugePageHeapPays(regional, params));
