@@ -689,7 +689,10 @@ bool FlipMesh::BuildEdgeRemoval(uint32_t t, int i, int j, double floor, bool abo
       arg[a][b] = -1;
       for (int c = a + 1; c < b; ++c) {
         const double sub = std::min(best[a][c], best[c][b]);
-        if (!(sub > std::max(best[a][b], prune))) continue;
+        if (!(sub > std::max(best[a][b], prune))) {
+          pruned = pruned || (sub > -kInf && !(sub > prune));  // for the rejection's count only
+          continue;
+        }
         const double v = std::min(sub, tri(a, c, b));
         if (v > best[a][b]) {  // ties: the smallest c
           best[a][b] = v;
