@@ -86,11 +86,10 @@ Distribution Distribution::Of(std::vector<double> values) {
   std::array<double*, 5> out{&d.p1, &d.p5, &d.p50, &d.p95, &d.p99};
   auto first = values.begin();
   for (size_t k = 0; k < pcts.size(); ++k) {
+    // The ranks ascend, so nth >= first: everything before first is <= it.
     const auto nth = values.begin() + static_cast<std::ptrdiff_t>(index(pcts[k]));
-    if (nth >= first) {
-      std::nth_element(first, nth, values.end());
-      first = nth;  // everything before nth is <= it; later ranks lie at or after it
-    }
+    std::nth_element(first, nth, values.end());
+    first = nth;
     *out[k] = *nth;
   }
   const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
