@@ -130,25 +130,33 @@ Vec3 OmegaMesh::FarPoint(TetId g) const {
   return m + (8.0 * half_side_ / geom::Norm(n)) * n;
 }
 
-void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* scratch) const {
-  // Most Voronoi facets of a clipped cell lie inside Ω: each pass below
-  // would copy them unchanged (every vertex inside, in order), so skip them.
-  bool all_inside = true;
-  for (const Vec3& p : *poly) {
-    for (int k = 0; k < 3 && all_inside; ++k) {
-      all_inside = geom::Orient1d(cube_.lo[k], p[k]) >= 0 && geom::Orient1d(p[k], cube_.hi[k]) >= 0;
+void ClipPolygonToBox(const geom::Box3& box, std::vector<Vec3>* poly, std::vector<Vec3>* scratch) {
+  // Sutherland–Hodgman against lo_k <= x_k and x_k <= hi_k. A pass against a
+  // plane no vertex is outside of copies the polygon unchanged (every vertex
+  // kept, in order, no crossing), so only the planes in the polygon's
+  // outcode are passed; the outcode is recomputed after each pass that
+  // clipped, since its new corners are rounded and may fall outside another
+  // plane. Most Voronoi facets of a clipped cell lie inside Ω (outcode 0).
+  // Bit 2k + side: some vertex has x_k < lo_k (side 0) or x_k > hi_k (side
+  // 1), the negation of `inside` below.
+  auto outcode = [&](const std::vector<Vec3>& pts) {
+    uint32_t code = 0;
+    for (const Vec3& p : pts) {
+      for (int k = 0; k < 3; ++k) {
+        code |= static_cast<uint32_t>(p[k] < box.lo[k]) << (2 * k);
+        code |= static_cast<uint32_t>(p[k] > box.hi[k]) << (2 * k + 1);
+      }
     }
-    if (!all_inside) break;
-  }
-  if (all_inside) return;
-  // Sutherland–Hodgman against lo_k <= x_k and x_k <= hi_k. Intersection
-  // points get the plane's coordinate exactly, so corners on ∂Ω are on ∂Ω.
-  for (int k = 0; k < 3 && !poly->empty(); ++k) {
-    for (int side = 0; side < 2 && !poly->empty(); ++side) {
-      const double bound = side == 0 ? cube_.lo[k] : cube_.hi[k];
-      auto inside = [&](const Vec3& p) {
-        return side == 0 ? geom::Orient1d(bound, p[k]) >= 0 : geom::Orient1d(p[k], bound) >= 0;
-      };
+    return code;
+  };
+  uint32_t code = outcode(*poly);
+  // Intersection points get the plane's coordinate exactly, so corners on ∂Ω
+  // are on ∂Ω.
+  for (int k = 0; k < 3 && code != 0; ++k) {
+    for (int side = 0; side < 2 && code != 0; ++side) {
+      if ((code & (1u << (2 * k + side))) == 0) continue;
+      const double bound = side == 0 ? box.lo[k] : box.hi[k];
+      auto inside = [&](const Vec3& p) { return side == 0 ? !(p[k] < bound) : !(p[k] > bound); };
       scratch->clear();
       const size_t n = poly->size();
       for (size_t i = 0; i < n; ++i) {
@@ -164,6 +172,7 @@ void OmegaMesh::ClipPolygonToCube(std::vector<Vec3>* poly, std::vector<Vec3>* sc
         }
       }
       poly->swap(*scratch);
+      code = outcode(*poly);  // 0 when the polygon is gone
     }
   }
 }
@@ -355,7 +364,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
       t = next;
       if (t == t0 || !t.valid()) break;
     }
-    ClipPolygonToCube(&poly_, &poly2_);
+    ClipPolygonToBox(cube_, &poly_, &poly2_);
     for (const Vec3& x : poly_) {
       const double d = geom::Dist(x, pv);
       if (d > best) {

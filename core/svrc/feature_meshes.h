@@ -62,6 +62,13 @@ struct TetLabel {
 };
 static_assert(sizeof(TetLabel) == 24);  // one per M_Ω tet slot
 
+// Clips the convex polygon `poly` (its vertices in order) to the box in
+// place, Sutherland–Hodgman against lo_k <= x_k and x_k <= hi_k in the order
+// x lo, x hi, y lo, ..., z hi; crossing points take the plane's coordinate
+// exactly. `scratch` is working space. A plane no vertex is outside of is
+// skipped: the same polygon, bit for bit, as passing all six.
+void ClipPolygonToBox(const geom::Box3& box, std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch);
+
 class OmegaMesh {
  public:
   // Ω = the axis-aligned cube with this centre and half side.
@@ -185,8 +192,6 @@ class OmegaMesh {
   // Size() without the memo.
   CellSize ComputeSize(VertexId v, Uniqueness* unique) const;
   static void FinishKept(bool from_kept, double kept_best, const geom::Vec3& pv, CellSize* out);
-  // Appends the polygon clipped to the cube to `out` (vertices only).
-  void ClipPolygonToCube(std::vector<geom::Vec3>* poly, std::vector<geom::Vec3>* scratch) const;
   // Circumcentre of finite tet t and whether it lies in Ω, cached per (slot,
   // generation): each tet is in four stars and Size() is called for every
   // cavity vertex (Figure 3.5).

@@ -97,6 +97,53 @@ TEST(Writers, TetgenRoundTripIsExact) {
   EXPECT_EQ(files, 3);
 }
 
+// The .ele/.face/.node lines are built in a line buffer with the region
+// attribute's text formatted once per value (session 25). Against the plain
+// per-field formatting: region attributes 0 and -0 (different text, equal
+// as doubles), alternating, a huge one and a negative one; vertex indices
+// past 10^9; negative markers.
+TEST(Writers, TetgenLinesAreTheFieldByFieldText) {
+  TetMesh m = Sample();
+  m.regions = {Region{0.0, 0}, Region{-0.0, 0}, Region{1e300, 0}, Region{-2.5, 0}};
+  for (size_t i = 0; i < m.tets.size(); ++i) m.tet_region[i] = static_cast<int32_t>((i * 7 / 3) % 4);
+  m.tet_region.back() = 9;  // no such region: attribute 0
+  m.tets[1] = {4000000000u, 1, 2, 999999999u};
+  m.triangle_marker[0] = -2147483647 - 1;
+  const std::string dir = svrc::testing::MakeTempDir("writers_lines");
+  ASSERT_TRUE(WriteMeshFile(m, dir + "/out.node").ok());
+  std::string header = "# svrc 0.1.0\n# parameters: radius_edge=2 theta=0.9\n# input sha256: abc123\n";
+  std::string node = header + std::to_string(m.positions.size()) + " 3 0 0\n";
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    node += std::to_string(i + 1);
+    for (int a = 0; a < 3; ++a) {
+      node += ' ';
+      internal::AppendDouble(&node, m.positions[i][a]);
+    }
+    node += '\n';
+  }
+  std::string ele = header + std::to_string(m.tets.size()) + " 4 1\n";
+  for (size_t i = 0; i < m.tets.size(); ++i) {
+    ele += std::to_string(i + 1);
+    for (int k = 0; k < 4; ++k) ele += " " + std::to_string(uint64_t{m.tets[i][k]} + 1);
+    ele += ' ';
+    const int32_t r = m.tet_region[i];
+    internal::AppendDouble(&ele, r >= 0 && r < 4 ? m.regions[r].attribute : 0.0);
+    ele += '\n';
+  }
+  std::string face = header + std::to_string(m.triangles.size()) + " 1\n";
+  for (size_t i = 0; i < m.triangles.size(); ++i) {
+    face += std::to_string(i + 1);
+    for (int k = 0; k < 3; ++k) face += " " + std::to_string(m.triangles[i][k] + 1);
+    face += " " + std::to_string(m.triangle_marker[i]) + "\n";
+  }
+  EXPECT_EQ(svrc::testing::ReadFileOrFail(dir + "/out.node"), node);
+  const std::string ele_written = svrc::testing::ReadFileOrFail(dir + "/out.ele");
+  EXPECT_EQ(ele_written, ele);
+  EXPECT_NE(ele_written.find(" -0\n"), std::string::npos);
+  EXPECT_NE(ele_written.find(" 4000000001 "), std::string::npos);
+  EXPECT_EQ(svrc::testing::ReadFileOrFail(dir + "/out.face"), face);
+}
+
 TEST(Writers, ReportsIoErrors) {
   const TetMesh m = Sample();
   const absl::Status s = WriteMeshFile(m, "/nonexistent-dir/x/out.msh");
