@@ -731,6 +731,29 @@ Delaunay3::StarAndNeighbors Delaunay3::StarAndNeighborsView(VertexId v) const {
   return {{star_buf_.data(), n}, {nbr_buf_.data(), m}, {nbr_tet_buf_.data(), m}};
 }
 
+std::vector<uint32_t> Delaunay3::Degrees() const {
+  std::vector<uint32_t> out;
+  if (!Is3d()) return out;
+  // F per vertex (tets at v, ghosts included) and whether one is a ghost
+  // (h); the finite neighbours are V − h = 2 + F/2 − h.
+  out.assign(points_.size(), 0);
+  std::vector<uint8_t> hull(points_.size(), 0);
+  for (uint32_t t = 0; t < TetCapacity(); ++t) {
+    const uint32_t* tv = &tets_[8 * t];
+    if (tv[0] == kFreeSlot) continue;
+    const bool ghost = tv[3] == kInf;
+    for (int k = 0; k < 4; ++k) {
+      if (tv[k] == kInf) continue;
+      ++out[tv[k]];
+      hull[tv[k]] |= static_cast<uint8_t>(ghost);
+    }
+  }
+  for (size_t v = 0; v < out.size(); ++v) {
+    if (out[v] != 0) out[v] = 2 + out[v] / 2 - hull[v];
+  }
+  return out;
+}
+
 bool Delaunay3::IsHullVertex(VertexId v) const {
   for (TetId t : StarView(v)) {
     if (tets_[8 * t.value() + 3] == kInf) return true;

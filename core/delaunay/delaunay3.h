@@ -198,6 +198,13 @@ class Delaunay3 {
   StarAndNeighbors StarAndNeighborsView(VertexId v) const;
   // True iff v is on the convex hull (incident to a ghost tet).
   bool IsHullVertex(VertexId v) const;
+  // Per vertex, the number of its neighbours (NeighborsView(v).size(); 0 for
+  // a pending vertex), from one pass over the tets instead of a star walk
+  // per vertex. Once Is3d(), the tets with the ghosts triangulate a 3-sphere,
+  // so v's link is a triangulated 2-sphere: V − E + F = 2 with 3F = 2E gives
+  // V = 2 + F/2, F = the tets at v (ghosts included), V its link's vertices,
+  // the infinite vertex among them when v is on the hull. Empty while !Is3d().
+  std::vector<uint32_t> Degrees() const;
   // Circumcentres of the finite tets incident to v (the corners of v's Voronoi
   // cell; for a hull vertex the cell is unbounded and this lists the finite
   // corners only).

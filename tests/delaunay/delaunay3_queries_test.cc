@@ -266,6 +266,57 @@ TEST(Delaunay3QueriesTest, CopiesKeepIndependentCaches) {
 
 // Queries on a triangulation that is not yet 3D answer empty, and the cache
 // does not remember those answers once tets exist.
+// Degrees() (Euler's formula on each vertex's link, one pass over the tets)
+// against the star walk's neighbour count, vertex by vertex: random points
+// (hull and interior), a grid (degenerate, cospherical: SoS decides), two
+// skew lines (stars of hundreds of tets), and while only a few points are in.
+void ExpectDegreesOfWalks(const Delaunay3& dt) {
+  const std::vector<uint32_t> deg = dt.Degrees();
+  ASSERT_EQ(deg.size(), dt.NumVertices());
+  uint32_t hull = 0;
+  for (uint32_t v = 0; v < dt.NumVertices(); ++v) {
+    const uint32_t walked = dt.VertexTet(VertexId(v)).valid() ? dt.NeighborsView(VertexId(v)).size() : 0;
+    ASSERT_EQ(deg[v], walked) << "vertex " << v;
+    hull += dt.VertexTet(VertexId(v)).valid() && dt.IsHullVertex(VertexId(v));
+  }
+  EXPECT_GT(hull, 0u);
+}
+
+TEST(Delaunay3QueriesTest, DegreesAreTheWalkedNeighbourCounts) {
+  {
+    Delaunay3 dt;
+    const std::vector<Vec3> pts = RandomPoints(3000, 25);
+    for (uint32_t i = 0; i < pts.size(); ++i) {
+      dt.Insert(pts[i], i);
+      if (i == 4 || i == 5 || i == 30) ExpectDegreesOfWalks(dt);
+    }
+    ExpectDegreesOfWalks(dt);
+  }
+  {
+    Delaunay3 dt;
+    uint32_t id = 0;
+    for (int x = 0; x < 7; ++x) {
+      for (int y = 0; y < 7; ++y) {
+        for (int z = 0; z < 7; ++z) dt.Insert(Vec3(x, y, z), id++);
+      }
+    }
+    ExpectDegreesOfWalks(dt);
+  }
+  {
+    Delaunay3 dt;
+    uint32_t id = 0;
+    for (int i = 0; i < 200; ++i) {
+      dt.Insert(Vec3(i / 200.0, 0, 0), id++);
+      dt.Insert(Vec3(0.5, i / 200.0, 1), id++);
+    }
+    uint32_t most = 0;
+    for (uint32_t d : dt.Degrees()) most = std::max(most, d);
+    EXPECT_GE(most, 200u);
+    ExpectDegreesOfWalks(dt);
+  }
+  EXPECT_TRUE(Delaunay3().Degrees().empty());
+}
+
 TEST(Delaunay3QueriesTest, PendingVertices) {
   Delaunay3 dt;
   dt.set_cache_neighbors(true);
