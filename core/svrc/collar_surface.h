@@ -69,11 +69,11 @@ struct CollarSurfaceOptions {
   // Tests (d)/(f), the link of a vertex not on a circle within one partial
   // sphere one cycle: exact or, false, by average degree. (b) counts an
   // edge's triangles over all of S, so a tail here (an edge with one triangle
-  // on this sphere and one on another) passes it. Exact measured in session
-  // 21: hinge.stl −10 rounds, bunny.off +10, and fandisk.off's stitched mesh
-  // leaked (FAILED_PRECONDITION "does not seal the facets"), so off by default
-  // until that leak is understood (docs/svrc-collars.md "Session 21").
-  bool exact_sphere_links = false;
+  // on this sphere and one on another) passes it, and so does a lollipop
+  // with the average degree of a cycle. Exact since session 25 (off in
+  // sessions 21–24: with it fandisk.off's stitched mesh leaked until session
+  // 23's stitch_faces_on_plane; measured: docs/svrc-collars.md "Session 25").
+  bool exact_sphere_links = true;
 };
 
 // One COLLAR event (Definition 38's RepBall B(x, radius) to destroy): insert x.

@@ -140,11 +140,14 @@ struct RefineOptions {
   // average degree, (b) covering the rest). Measured in docs/svrc-collars.md
   // "Session 21": more rounds on 5 of 11 crease inputs.
   bool collar_exact_vertex_links = false;
-  // CollarSurfaceOptions::exact_sphere_links (tests (d)/(f) exact). Off:
-  // with it fandisk.off's stitched mesh leaked (docs/svrc-collars.md
-  // "Session 21"); since session 23 (stitch_faces_on_plane) it meshes, but
-  // the other long inputs have not been rerun with it.
-  bool collar_exact_sphere_links = false;
+  // CollarSurfaceOptions::exact_sphere_links (tests (d)/(f) exact: each
+  // partial sphere's restricted link of a vertex one cycle, as the topology
+  // condition asks, not a cycle's average degree). The default since session
+  // 25: fandisk.off meshes with it since session 23 (stitch_faces_on_plane),
+  // and bunny.off, hinge.stl and the other crease inputs were rerun with it
+  // (docs/svrc-collars.md "Session 25": bunny +1.0% tets, +4% CPU; hinge
+  // −1.5% tets, −11% CPU). false: the average-degree test of sessions 20–24.
+  bool collar_exact_sphere_links = true;
   // The stitched mesh's faces on a facet F also include a face with two
   // points on F and one point of Ω lying on F's plane within the conformity
   // checker's tolerance (8 ulps of the PLC's largest coordinate) whose
