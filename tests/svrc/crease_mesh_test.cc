@@ -517,7 +517,8 @@ TEST(CreaseMesh, LONG_FandiskMeshes) {
 }
 
 // fandisk.off with exact sphere links (RefineOptions::collar_exact_sphere_links,
-// off by default since session 21 because of this): the stitched mesh leaked,
+// off by default in sessions 21–24 because of this; the default since session
+// 25, set here explicitly all the same): the stitched mesh leaked,
 // "does not seal the facets". A Voronoi vertex of M_Ω lay on facet 4560 (an
 // input triangle) at 0.976 collar radii, where the facet's points are
 // suppressed: the Ω ball's yields to the facet's balls converged on it (56
