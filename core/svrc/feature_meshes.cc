@@ -100,7 +100,7 @@ OmegaMesh::CcEntry OmegaMesh::ComputeCircumcenter(TetId t) const {
   return e;
 }
 
-OmegaMesh::CcEntry OmegaMesh::CachedCircumcenter(TetId t) const {
+OmegaMesh::CcEntry OmegaMesh::CachedCircumcenterSlow(TetId t) const {
   const uint32_t i = t.value();
   if (i > CcRecord::kSlotMask) [[unlikely]] return ComputeCircumcenter(t);
   GrowTable(cc_, i, size_t{dt_.TetCapacity()} + 64, cc_limit_, CcRecord::kSlotMask,
