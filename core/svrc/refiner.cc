@@ -3119,16 +3119,26 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
   // dihedrals (atan2 per edge) are measured only for the others.
   const double sin_min = std::sin(min_deg * M_PI / 180) * (1 + 1e-6);
   const bool reuse = !first && options_.reuse_round_work;
-  for (TetId t : dt.FiniteTets()) {
-    const TetLabel* lab = LiveLabel(t);
-    if (lab == nullptr) continue;
-    // TetLabel::sliver_clear: set below on every live label a round reads,
-    // so the first round leaves none stale; new tets' labels start clear of it.
-    bool& clear = tet_labels_[t.value()].sliver_clear;
-    if (reuse && clear) {
+  // The slots in order, as FiniteTets() lists them. A label marked
+  // sliver_clear whose generation is its slot's is a live finite tet (only
+  // finite tets' labels are ever marked, below, and a new tet's label starts
+  // unmarked), so a later round skips it reading the label and the slot's
+  // generation only, not the tet (32 bytes per slot: most of the rounds'
+  // memory traffic on cube --max-volume 1e-6, where they skip 5.6 M tets).
+  const uint32_t slots = dt.TetCapacity();
+  for (uint32_t s = 0; s < slots; ++s) {
+    const TetId t(s);
+    if (reuse && s < tet_labels_.size() && tet_labels_[s].sliver_clear && LiveLabel(t) != nullptr) {
       ++stats_.sliver_scan_reused;
       continue;
     }
+    if (!dt.IsAlive(t) || dt.IsGhost(t)) continue;
+    const TetLabel* lab = LiveLabel(t);
+    if (lab == nullptr) continue;
+    // TetLabel::sliver_clear: set below on every live label a round reads,
+    // so the first round leaves none stale; new tets' labels start clear of
+    // it. (A later round skipped the marked ones above.)
+    bool& clear = tet_labels_[t.value()].sliver_clear;
     clear = true;  // until a test below keeps it
     if (!lab->kept) continue;
     std::array<Vec3, 4> x;
