@@ -28,7 +28,7 @@ class LineBuffer {
     return *this;
   }
   LineBuffer& Double(double v) {
-    end_ = std::to_chars(end_, buf_ + sizeof(buf_), v).ptr;
+    end_ = FormatDouble(end_, v);
     return *this;
   }
   LineBuffer& Text(std::string_view s) {
@@ -47,7 +47,7 @@ class LineBuffer {
 
  private:
   // Longest line: a .node line, an index (≤ 20 digits) and three shortest
-  // round-trip doubles (≤ 24 characters each), separators and '\n'.
+  // round-trip doubles (≤ kMaxDoubleChars each), separators and '\n'.
   char buf_[160];
   char* end_ = buf_;
 };

@@ -2,6 +2,7 @@
 // provenance text, number formatting. Internal to core/mesh.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,10 @@ absl::Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::
 std::vector<std::string> ProvenanceLines(const Provenance& p);
 
 // The shortest decimal that round-trips (std::to_chars): every double exactly.
+// FormatDouble writes it at `out`, which must have room for kMaxDoubleChars,
+// and returns the end; AppendDouble appends it to a string.
+inline constexpr size_t kMaxDoubleChars = 24;
+char* FormatDouble(char* out, double v);
 void AppendDouble(std::string* out, double v);
 
 }  // namespace svrc::mesh::internal

@@ -61,7 +61,7 @@ TEST(Writers, AppendDoubleReadsBackBitForBit) {
   for (double v : values) {
     std::string s;
     internal::AppendDouble(&s, v);
-    ASSERT_LE(s.size(), 24u) << s;
+    ASSERT_LE(s.size(), internal::kMaxDoubleChars) << s;
     const double back = std::strtod(s.c_str(), nullptr);
     uint64_t a, b;
     std::memcpy(&a, &v, sizeof v);
