@@ -47,7 +47,9 @@ void OmegaMesh::AddVertex(VertexId v, PointId p) {
 bool OmegaMesh::InsideCube(const Vec3& p) const {
   // Exact coordinate comparisons: Orient1d(lo, x) >= 0 and Orient1d(x, hi)
   // >= 0, without its per-call counter (a thread-local increment, six per
-  // circumcentre; ~1% of cube --max-volume 1e-5's instructions).
+  // circumcentre; ~1% of cube --max-volume 1e-5's instructions). Not
+  // Box3::Contains: that answers false for a NaN coordinate, Orient1d's test
+  // true, and a flat tet's circumcentre may be NaN.
   for (int k = 0; k < 3; ++k) {
     if (p[k] < cube_.lo[k] || p[k] > cube_.hi[k]) return false;
   }

@@ -3128,16 +3128,15 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
   const uint32_t slots = dt.TetCapacity();
   for (uint32_t s = 0; s < slots; ++s) {
     const TetId t(s);
-    if (reuse && s < tet_labels_.size() && tet_labels_[s].sliver_clear && LiveLabel(t) != nullptr) {
+    const TetLabel* lab = LiveLabel(t);
+    if (lab == nullptr) continue;  // a free slot, or a tet without a label
+    if (reuse && lab->sliver_clear) {
       ++stats_.sliver_scan_reused;
       continue;
     }
     if (!dt.IsAlive(t) || dt.IsGhost(t)) continue;
-    const TetLabel* lab = LiveLabel(t);
-    if (lab == nullptr) continue;
     // TetLabel::sliver_clear: set below on every live label a round reads,
-    // so the first round leaves none stale; new tets' labels start clear of
-    // it. (A later round skipped the marked ones above.)
+    // so the first round leaves none stale; new tets' labels start clear of it.
     bool& clear = tet_labels_[t.value()].sliver_clear;
     clear = true;  // until a test below keeps it
     if (!lab->kept) continue;
