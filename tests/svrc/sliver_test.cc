@@ -439,6 +439,98 @@ TEST(Sliver, RandomDelaunayMeshesKeepUnionBoundaryAndConstraints) {
   EXPECT_GT(sequences, 0u);  // the depth-2 search was exercised (and kept every invariant above)
 }
 
+// The face adjacency of `tets` from a map of sorted faces (independent of
+// TetFaces): per slot 4t + f the slot of the same face in the other tet, or
+// UINT32_MAX.
+std::vector<uint32_t> BruteForceNeighborSlots(const std::vector<Tet>& tets) {
+  std::map<Tri, std::vector<uint32_t>> slots;
+  for (uint32_t t = 0; t < tets.size(); ++t) {
+    for (int f = 0; f < 4; ++f) {
+      Tri k{};
+      int j = 0;
+      for (int i = 0; i < 4; ++i) {
+        if (i != f) k[j++] = tets[t][i];
+      }
+      std::sort(k.begin(), k.end());
+      slots[k].push_back(4 * t + static_cast<uint32_t>(f));
+    }
+  }
+  std::vector<uint32_t> out(4 * tets.size(), UINT32_MAX);
+  for (const auto& [k, v] : slots) {
+    if (v.size() != 2) continue;
+    out[v[0]] = v[1];
+    out[v[1]] = v[0];
+  }
+  return out;
+}
+
+// SliverInput::neighbor_slots (the refiner's adjacency, docs/svrc-design.md
+// §8 item 52): given the adjacency, the pass builds no face table and must
+// make the same flips, with constrained faces blocking the same ones (they
+// are found in the stars of their smallest vertices and marked on both
+// sides). Either way SliverResult::neighbor_slots is the adjacency of its
+// output tets (the output's labelling takes it), checked against a map of
+// faces. Random Delaunay meshes with a jittered grid; constrained: the faces
+// closing off the grid's tets, every 3rd other interior face and every 7th
+// edge; keep_max_volume on (its per-component bound reads the constrained
+// faces' marks on both sides).
+TEST(Sliver, GivenAdjacencyMakesTheSameFlipsAndReturnsTheOutputs) {
+  uint64_t blocked = 0;
+  for (uint64_t seed : {7u, 8u, 9u}) {
+    const std::vector<Vec3> pos = RandomPointsAndJitteredGrid(seed, 150);
+    absl::StatusOr<delaunay::PointSetResult> del = delaunay::TetrahedralizePointSet(pos);
+    ASSERT_TRUE(del.ok()) << del.status();
+    const std::vector<Tet>& tets = del->tets;
+    const std::vector<uint32_t> adjacency = BruteForceNeighborSlots(tets);
+    // Closed off: the tets with their centroid above z = 1.1 (the jittered
+    // grid's slivers) from the rest, so that the components differ.
+    auto upper = [&](uint32_t t) {
+      double z = 0;
+      for (uint32_t v : tets[t]) z += pos[v].z;
+      return z > 4 * 1.1;
+    };
+    std::vector<Tri> faces;
+    std::vector<Edge> edges;
+    for (uint32_t s = 0, k = 0; s < adjacency.size(); ++s) {
+      if (adjacency[s] == UINT32_MAX || adjacency[s] < s) continue;
+      if (upper(s / 4) == upper(adjacency[s] / 4) && k++ % 3 != 0) continue;
+      const Tet& t = tets[s / 4];
+      Tri f{};
+      int j = 0;
+      for (int i = 0; i < 4; ++i) {
+        if (i != static_cast<int>(s % 4)) f[j++] = t[i];
+      }
+      faces.push_back(f);
+      if (k % 7 == 1) edges.push_back({f[0], f[1]});
+    }
+    SliverOptions opt;
+    opt.target_min_dihedral_deg = 15;
+    opt.max_radius_edge = 3;
+    opt.keep_max_volume = true;  // reads the components, which the constrained faces bound
+    std::vector<SliverResult> runs;
+    for (bool given : {false, true}) {
+      SliverInput in{pos, tets, faces, edges};
+      if (given) in.neighbor_slots = adjacency;
+      absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+      ASSERT_TRUE(r.ok()) << r.status();
+      EXPECT_EQ(r->neighbor_slots, BruteForceNeighborSlots(r->tets)) << "seed " << seed << " given " << given;
+      runs.push_back(std::move(*r));
+    }
+    const SliverStats& a = runs[0].stats;
+    const SliverStats& b = runs[1].stats;
+    EXPECT_EQ(runs[0].tets, runs[1].tets) << "seed " << seed;
+    EXPECT_EQ(a.flips(), b.flips()) << "seed " << seed;
+    EXPECT_EQ(a.candidates, b.candidates) << "seed " << seed;
+    EXPECT_EQ(a.rejected_constraint, b.rejected_constraint) << "seed " << seed;
+    EXPECT_EQ(a.rejected_volume, b.rejected_volume) << "seed " << seed;
+    EXPECT_EQ(a.min_dihedral_after, b.min_dihedral_after) << "seed " << seed;
+    EXPECT_GT(a.flips(), 0u) << "seed " << seed;
+    for (const Tri& f : faces) EXPECT_TRUE(HasFace(runs[1].tets, f));
+    blocked += b.rejected_constraint;
+  }
+  EXPECT_GT(blocked, 0u);  // constrained faces and edges did block flips
+}
+
 // SliverOptions::prune_edge_removals: an edge removal leaves out the ring
 // triangles whose first tet is no better than the flip it must beat (the
 // caller's floor, the ring's old worst, the best flip so far). The dynamic

@@ -100,5 +100,64 @@ TEST(TetFaces, ReportsTheSmallestFaceInMoreThanTwoTets) {
   EXPECT_EQ(bad.slots[2] / 4, 2u);
 }
 
+// VertexTets: the stars of the chosen vertices only, each in increasing tet
+// order and without dead tets; FindFace gives the slot of the face in the
+// first tet of the smallest vertex's star that holds it (against the
+// brute-force map), and kNoSlot for three vertices that are no face.
+TEST(VertexTets, StarsAndFacesMatchBruteForce) {
+  uint32_t nv = 0;
+  const std::vector<Tet> tets = GridTets(4, &nv);
+  std::vector<uint8_t> alive(tets.size(), 1);
+  for (size_t t = 0; t < tets.size(); t += 5) alive[t] = 0;
+  std::vector<uint8_t> needed(nv, 0);
+  for (uint32_t v = 0; v < nv; v += 3) needed[v] = 1;
+  const VertexTets stars(tets, needed, alive);
+  for (uint32_t v = 0; v < nv; ++v) {
+    std::vector<uint32_t> want;
+    for (uint32_t t = 0; t < tets.size(); ++t) {
+      if (needed[v] && alive[t] && std::find(tets[t].begin(), tets[t].end(), v) != tets[t].end()) want.push_back(t);
+    }
+    const std::span<const uint32_t> got = stars.Star(v);
+    EXPECT_EQ(std::vector<uint32_t>(got.begin(), got.end()), want) << "vertex " << v;
+  }
+  std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> slots;  // live tets only, increasing slot
+  for (uint32_t t = 0; t < tets.size(); ++t) {
+    if (!alive[t]) continue;
+    for (int f = 0; f < 4; ++f) slots[FaceOf(tets[t], f)].push_back(4 * t + f);
+  }
+  int found = 0;
+  for (const auto& [k, s] : slots) {
+    if (!needed[k[0]]) continue;
+    EXPECT_EQ(stars.FindFace(k[0], k[1], k[2]), s.front());
+    ++found;
+  }
+  EXPECT_GT(found, 100);
+  // A dead tet's faces that no live tet has, and a triple that is no face.
+  int dead_only = 0;
+  for (uint32_t t = 0; t < tets.size(); ++t) {
+    if (alive[t]) continue;
+    for (int f = 0; f < 4; ++f) {
+      const std::array<uint32_t, 3> k = FaceOf(tets[t], f);
+      if (!needed[k[0]] || slots.count(k)) continue;
+      EXPECT_EQ(stars.FindFace(k[0], k[1], k[2]), VertexTets::kNoSlot);
+      ++dead_only;
+    }
+  }
+  EXPECT_GT(dead_only, 0);
+  // A neighbour b of a and a vertex c in none of a's tets: {a, b, c} is no face.
+  const uint32_t a = 0;  // a needed vertex
+  ASSERT_FALSE(stars.Star(a).empty());
+  const Tet& first = tets[stars.Star(a).front()];
+  const uint32_t b = first[0] != a ? first[0] : first[1];
+  uint32_t c = nv;
+  for (uint32_t v = 0; v < nv && c == nv; ++v) {
+    bool in_star = false;
+    for (uint32_t t : stars.Star(a)) in_star = in_star || std::find(tets[t].begin(), tets[t].end(), v) != tets[t].end();
+    if (!in_star) c = v;
+  }
+  ASSERT_LT(c, nv);
+  EXPECT_EQ(stars.FindFace(a, b, c), VertexTets::kNoSlot);
+}
+
 }  // namespace
 }  // namespace svrc::refine
