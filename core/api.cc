@@ -402,21 +402,16 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   const bool dumping = dump_env != nullptr && *dump_env != '\0';
   std::vector<std::array<uint32_t, 4>> tets_before_flips;
   if (dumping && use_collars) tets_before_flips = refined->tets;
-  // The refiner's adjacency goes into the flips, theirs into the labelling:
-  // no face table is built for either (docs/svrc-design.md §8 item 52).
-  absl::StatusOr<refine::SliverResult> flipped =
-      refine::RemoveSlivers(refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver,
-                            refined->tet_neighbors);
+  absl::StatusOr<refine::SliverResult> flipped = refine::RemoveSlivers(
+      refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver);
   if (!flipped.ok()) return flipped.status();
   flipped->stats.ExportTo(&stats);
   refined->tets = std::move(flipped->tets);
-  refined->tet_neighbors.clear();
-  refined->tet_neighbors.shrink_to_fit();
   // The refiner's exact normalisation x' = (x − t)·2^−e.
   const refine::CoordinateMap map = refine::CoordinateMapOf(*refined);
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex, faces, map,
-                              keep_box, &stats, flipped->neighbor_slots);
+                              keep_box, &stats);
   if (!out.ok()) {
     // The labelling says "no tetrahedron is left" (INVALID_ARGUMENT) for an
     // open surface or hole seeds that fill every region. Validation has

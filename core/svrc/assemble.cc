@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <tuple>
 #include <utility>
 
@@ -12,7 +11,6 @@
 #include "absl/strings/str_format.h"
 #include "core/geometry/predicates.h"
 #include "core/mesh/canonical.h"
-#include "core/svrc/tet_faces.h"
 
 namespace svrc::refine {
 namespace {
@@ -250,8 +248,7 @@ absl::StatusOr<OutputStageResult> BuildOutputMesh(const plc::Plc& plc,
                                                   std::span<const uint32_t> input_vertex,
                                                   std::span<const ConstrainedFace> constrained_faces,
                                                   const CoordinateMap& map, bool keep_bounding_box,
-                                                  const mesh::MeshStats* stats,
-                                                  std::span<const uint32_t> neighbor_slots) {
+                                                  const mesh::MeshStats* stats) {
   std::vector<plc::RegionSeed> seeds = plc.regions;
   for (plc::RegionSeed& s : seeds) s.point = map.ToMesher(s.point);
   std::vector<Vec3> holes(plc.holes.size());
@@ -264,18 +261,6 @@ absl::StatusOr<OutputStageResult> BuildOutputMesh(const plc::Plc& plc,
   li.region_seeds = seeds;
   li.hole_seeds = holes;
   li.keep_bounding_box = keep_bounding_box;
-  // Given adjacency: the constrained faces are found in the stars of their
-  // smallest vertices (the labelling asks with the face's sorted vertices).
-  std::optional<VertexTets> stars;
-  if (neighbor_slots.size() == 4 * tets.size()) {
-    std::vector<uint8_t> needed(positions.size(), 0);
-    for (const ConstrainedFace& f : constrained_faces) {
-      if (std::max({f.v[0], f.v[1], f.v[2]}) < positions.size()) needed[std::min({f.v[0], f.v[1], f.v[2]})] = 1;
-    }
-    stars.emplace(tets, needed);
-    li.neighbor_slots = neighbor_slots;
-    li.find_face = [&](uint32_t a, uint32_t b, uint32_t c) { return stars->FindFace(a, b, c); };
-  }
   absl::StatusOr<Labelling> lab = LabelRegions(li);
   if (!lab.ok()) return lab.status();
 

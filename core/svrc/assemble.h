@@ -80,10 +80,6 @@ absl::StatusOr<AssembledMesh> AssembleMesh(const AssembleInput& input);
 
 // The whole output stage in one call: maps the PLC's seeds with `map`, labels
 // (LabelRegions), assembles (AssembleMesh). Label issues are returned too.
-// `neighbor_slots` (optional): the tets' face adjacency as
-// LabelInput::neighbor_slots (SliverResult::neighbor_slots,
-// PointSetRefinement::tet_neighbors); with it the labelling builds no face
-// table and trusts the tets to form a tetrahedralization.
 struct OutputStageResult {
   mesh::TetMesh mesh;
   AssembleReport report;
@@ -95,7 +91,6 @@ absl::StatusOr<OutputStageResult> BuildOutputMesh(const plc::Plc& plc,
                                                   std::span<const uint32_t> input_vertex,
                                                   std::span<const ConstrainedFace> constrained_faces,
                                                   const CoordinateMap& map, bool keep_bounding_box,
-                                                  const mesh::MeshStats* stats = nullptr,
-                                                  std::span<const uint32_t> neighbor_slots = {});
+                                                  const mesh::MeshStats* stats = nullptr);
 
 }  // namespace svrc::refine

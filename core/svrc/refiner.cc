@@ -502,11 +502,6 @@ class Refiner {
   // circumcentre and radius. Tets whose circumcentre Size()
   // would not read plainly (flat, outside Ω) are never bad here.
   bool TetBad(TetId t, Vec3* cc, double* radius) const;
-  // The face adjacency of M_Ω's finite tets `tets` (FiniteTets order) as
-  // LabelInput::neighbor_slots: per slot 4i + f the slot of the same face in
-  // the neighbouring tet of the list, kNoTet on the hull. *compact (if not
-  // null): per tet slot of M_Ω its index in `tets`.
-  std::vector<uint32_t> NeighborSlots(std::span<const TetId> tets, std::vector<uint32_t>* compact) const;
   // Enqueues t's Skinny event when TetBad; returns whether it did.
   bool EnqueueTetIfBad(TetId t);
   // t's label (tet_labels_) when it is t's own (set or carried for the tet
@@ -1833,22 +1828,6 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   return r > lab->target;
 }
 
-std::vector<uint32_t> Refiner::NeighborSlots(std::span<const TetId> tets, std::vector<uint32_t>* compact) const {
-  const delaunay::Delaunay3& dt = omega_.dt();
-  std::vector<uint32_t> own;
-  std::vector<uint32_t>& index = compact != nullptr ? *compact : own;
-  index.assign(dt.TetCapacity(), kNoTet);
-  for (uint32_t i = 0; i < tets.size(); ++i) index[tets[i].value()] = i;
-  std::vector<uint32_t> slots(4 * tets.size(), kNoTet);
-  for (uint32_t i = 0; i < tets.size(); ++i) {
-    for (int f = 0; f < 4; ++f) {
-      const TetId n = dt.Neighbor(tets[i], f);
-      if (!dt.IsGhost(n)) slots[4 * i + f] = 4 * index[n.value()] + dt.NeighborFace(tets[i], f);
-    }
-  }
-  return slots;
-}
-
 bool Refiner::EnqueueTetIfBad(TetId t) {
   Vec3 cc;
   double r = 0;
@@ -3024,7 +3003,15 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   std::vector<uint32_t> compact, neighbor_slots;
   std::vector<TetId> star;
   if (!tet_ids.empty() && options_.label_with_adjacency) {
-    neighbor_slots = NeighborSlots(tet_ids, &compact);
+    compact.assign(dt.TetCapacity(), kNoTet);
+    for (uint32_t i = 0; i < tet_ids.size(); ++i) compact[tet_ids[i].value()] = i;
+    neighbor_slots.assign(4 * tet_ids.size(), kNoTet);
+    for (uint32_t i = 0; i < tet_ids.size(); ++i) {
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = dt.Neighbor(tet_ids[i], f);
+        if (!dt.IsGhost(n)) neighbor_slots[4 * i + f] = 4 * compact[n.value()] + dt.NeighborFace(tet_ids[i], f);
+      }
+    }
     in.neighbor_slots = neighbor_slots;
     in.find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
       dt.Star(VertexId(a), &star);
@@ -3519,9 +3506,6 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
         out.tet_outside.push_back(lab != nullptr && !lab->kept ? 1 : 0);
       }
     }
-    // Delaunay3's adjacency over the compacted tets: the sliver pass and the
-    // output's labelling then build no face table (§8 item 52).
-    out.tet_neighbors = NeighborSlots(finite, nullptr);
   }
   std::vector<uint8_t> in_stitched;
   if (stitched_done_) {

@@ -351,11 +351,6 @@ struct PointSetRefinement {
   // Tets of M_Ω over `positions`, positively oriented in normalised
   // coordinates (Delaunay3's invariant), in Delaunay3 slot order.
   std::vector<std::array<uint32_t, 4>> tets;
-  // The face adjacency of `tets` when they are M_Ω's (empty after
-  // RipStitchCollar): per slot 4t + f (the face opposite local vertex f of
-  // tet t) the slot of the same face in the neighbouring tet, or
-  // 0xFFFFFFFF on Ω's hull (SliverInput / LabelInput::neighbor_slots).
-  std::vector<uint32_t> tet_neighbors;
   // Per tet of `tets` (empty unless M_Ω was labelled during the refinement
   // and not stitched): 1 = known to lie outside the output (exterior or
   // hole). SliverOptions::skip_tet.

@@ -188,9 +188,7 @@ class FlipMesh {
   absl::Status Init(const SliverInput& in);
   void Run();
   absl::Status CheckConstraints() const;
-  // The live tets in slot order, and their adjacency as
-  // SliverResult::neighbor_slots.
-  std::vector<Tet> Output(std::vector<uint32_t>* neighbor_slots) const;
+  std::vector<Tet> Output() const;
   void Summarize(bool before);
 
  private:
@@ -322,23 +320,13 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
     }
     quality_[t] = MeasureInput(pos_, v, sin_target);
   }
-  // Adjacency: given (SliverInput::neighbor_slots), or the 4T faces grouped
-  // by their vertex sets, as LabelRegions does (tet_faces.h: no hashing, no
-  // sort of all 4T records, which took ~5% of a volume-bound run). Same
-  // pairs and the same error (the smallest face in > 2 tets) as sorting all
-  // records by (key, tet, face). Kept until the constrained faces are marked
-  // below.
-  const bool given = in.neighbor_slots.size() == 4 * num_tets;
-  std::optional<TetFaces> tet_faces;
-  if (given) {
-    for (size_t t = 0; t < num_tets; ++t) {
-      for (int f = 0; f < 4; ++f) {
-        const uint32_t s = in.neighbor_slots[4 * t + f];
-        nbr_[t][f] = s == kNone ? kNone : s / 4;
-      }
-    }
-  } else {
-    tet_faces.emplace(std::span<const Tet>(tet_), n);
+  // Adjacency: the 4T faces grouped by their vertex sets, as LabelRegions
+  // does (tet_faces.h: no hashing, no sort of all 4T records, which took ~5%
+  // of a volume-bound run). Same pairs and the same error (the smallest face
+  // in > 2 tets) as sorting all records by (key, tet, face). Kept until the
+  // constrained faces are marked below.
+  std::optional<TetFaces> tet_faces(std::in_place, std::span<const Tet>(tet_), n);
+  {
     TetFaces::Overused bad;
     if (!tet_faces->Match(
             [&](uint32_t s, uint32_t t) {
@@ -373,26 +361,12 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // FaceKey + a binary search over cfaces_ for each of the 4T faces. A face
   // that is not in the mesh marks nothing (CheckConstraints reports it).
   std::vector<uint8_t> constrained(num_tets, 0);
-  if (given) {
-    // The face in the star of its smallest vertex, and across it.
-    std::vector<uint8_t> needed(n, 0);
-    for (const Tri& k : cfaces_) needed[k[0]] = 1;
-    const VertexTets stars(tet_, needed);
-    for (const Tri& k : cfaces_) {
-      const uint32_t s = stars.FindFace(k[0], k[1], k[2]);
-      if (s == VertexTets::kNoSlot) continue;
-      constrained[s / 4] |= static_cast<uint8_t>(1u << (s % 4));
-      const uint32_t o = in.neighbor_slots[s];
-      if (o != kNone) constrained[o / 4] |= static_cast<uint8_t>(1u << (o % 4));
+  for (const Tri& k : cfaces_) {
+    for (const TetFace& f : tet_faces->Bucket(k[0])) {
+      if (f.b == k[1] && f.c == k[2]) constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4));
     }
-  } else {
-    for (const Tri& k : cfaces_) {
-      for (const TetFace& f : tet_faces->Bucket(k[0])) {
-        if (f.b == k[1] && f.c == k[2]) constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4));
-      }
-    }
-    tet_faces.reset();
   }
+  tet_faces.reset();
   absl::Status s = CheckConstraints();
   if (!s.ok()) return s;
   // Components: flood fill across non-constrained faces, in tet order.
@@ -428,19 +402,34 @@ absl::Status FlipMesh::CheckConstraints() const {
   std::vector<uint8_t> needed(pos_.size(), 0);
   for (const Tri& f : cfaces_) needed[f[0]] = 1;
   for (const Edge& e : cedges_) needed[e[0]] = 1;
-  const VertexTets stars(tet_, needed, alive_);
+  std::vector<uint32_t> start(pos_.size() + 1, 0);
+  for (size_t t = 0; t < tet_.size(); ++t) {
+    if (!alive_[t]) continue;
+    for (uint32_t v : tet_[t]) start[v + 1] += needed[v];
+  }
+  for (size_t v = 0; v < pos_.size(); ++v) start[v + 1] += start[v];
+  std::vector<uint32_t> star(start.back());
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t t = 0; t < tet_.size(); ++t) {
+    if (!alive_[t]) continue;
+    for (uint32_t v : tet_[t]) {
+      if (needed[v]) star[fill[v]++] = static_cast<uint32_t>(t);
+    }
+  }
+  auto has = [&](const Tet& t, uint32_t v) { return t[0] == v || t[1] == v || t[2] == v || t[3] == v; };
   for (const Tri& f : cfaces_) {
-    if (stars.FindFace(f[0], f[1], f[2]) == VertexTets::kNoSlot) {
+    bool found = false;
+    for (uint32_t k = start[f[0]]; k < start[f[0] + 1] && !found; ++k) {
+      found = has(tet_[star[k]], f[1]) && has(tet_[star[k]], f[2]);
+    }
+    if (!found) {
       return absl::InvalidArgumentError(
           absl::StrCat("sliver: constrained face (", f[0], ", ", f[1], ", ", f[2], ") is not a face of the mesh"));
     }
   }
-  auto has = [&](const Tet& t, uint32_t v) { return t[0] == v || t[1] == v || t[2] == v || t[3] == v; };
   for (const Edge& e : cedges_) {
     bool found = false;
-    for (uint32_t t : stars.Star(e[0])) {
-      if ((found = has(tet_[t], e[1]))) break;
-    }
+    for (uint32_t k = start[e[0]]; k < start[e[0] + 1] && !found; ++k) found = has(tet_[star[k]], e[1]);
     if (!found) {
       return absl::InvalidArgumentError(
           absl::StrCat("sliver: constrained edge (", e[0], ", ", e[1], ") is not an edge of the mesh"));
@@ -1037,24 +1026,11 @@ void FlipMesh::Summarize(bool before) {
   }
 }
 
-std::vector<Tet> FlipMesh::Output(std::vector<uint32_t>* neighbor_slots) const {
+std::vector<Tet> FlipMesh::Output() const {
   std::vector<Tet> out;
-  std::vector<uint32_t> index(tet_.size(), kNone);  // slot -> output index
+  out.reserve(tet_.size());
   for (size_t t = 0; t < tet_.size(); ++t) {
-    if (alive_[t]) index[t] = static_cast<uint32_t>(out.size()), out.push_back(tet_[t]);
-  }
-  // Across face f of t: the face of the neighbour n whose neighbour is t (two
-  // tets share at most one face).
-  neighbor_slots->assign(4 * out.size(), kNone);
-  for (size_t t = 0; t < tet_.size(); ++t) {
-    if (!alive_[t]) continue;
-    for (int f = 0; f < 4; ++f) {
-      const uint32_t n = nbr_[t][f];
-      if (n == kNone) continue;
-      int g = 0;
-      while (g < 4 && nbr_[n][g] != t) ++g;
-      (*neighbor_slots)[4 * index[t] + f] = 4 * index[n] + static_cast<uint32_t>(g);
-    }
+    if (alive_[t]) out.push_back(tet_[t]);
   }
   return out;
 }
@@ -1184,7 +1160,7 @@ absl::StatusOr<SliverResult> RemoveSlivers(const SliverInput& input, const Slive
   mesh.Summarize(/*before=*/false);
   s = mesh.CheckConstraints();
   if (!s.ok()) return absl::InternalError(absl::StrCat("sliver: after flipping: ", s.message()));
-  result.tets = mesh.Output(&result.neighbor_slots);
+  result.tets = mesh.Output();
   result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -1193,8 +1169,7 @@ absl::StatusOr<SliverResult> RemoveSlivers(std::span<const geom::Vec3> positions
                                            std::span<const std::array<uint32_t, 4>> tets,
                                            std::span<const ConstrainedFace> faces,
                                            std::span<const std::vector<uint32_t>> segment_chains,
-                                           const SliverOptions& options,
-                                           std::span<const uint32_t> neighbor_slots) {
+                                           const SliverOptions& options) {
   std::vector<Tri> cfaces;
   cfaces.reserve(faces.size());
   for (const ConstrainedFace& f : faces) cfaces.push_back(f.v);
@@ -1207,7 +1182,6 @@ absl::StatusOr<SliverResult> RemoveSlivers(std::span<const geom::Vec3> positions
   in.tets = tets;
   in.constrained_faces = cfaces;
   in.constrained_edges = cedges;
-  in.neighbor_slots = neighbor_slots;
   return RemoveSlivers(in, options);
 }
 

@@ -145,12 +145,6 @@ struct SliverInput {
   // `tets`.
   std::span<const std::array<uint32_t, 3>> constrained_faces;
   std::span<const std::array<uint32_t, 2>> constrained_edges;
-  // Optional face adjacency of `tets`, as LabelInput::neighbor_slots: per
-  // slot 4t + f (the face opposite local vertex f of tet t) the slot of the
-  // same face in the other tet, or kNoTet. With it (4 per tet) the pass
-  // builds no face table (TetFaces) and trusts the tets to form a
-  // tetrahedralization; the flips are the same.
-  std::span<const uint32_t> neighbor_slots = {};
 };
 
 struct SliverResult {
@@ -161,9 +155,6 @@ struct SliverResult {
   // constrained edge an edge. Surviving input tets keep their vertex order;
   // the order of the list is deterministic (slot order of the flip structure).
   std::vector<std::array<uint32_t, 4>> tets;
-  // The face adjacency of `tets` in the form of SliverInput::neighbor_slots
-  // (LabelInput::neighbor_slots: the output's labelling needs no face table).
-  std::vector<uint32_t> neighbor_slots;
   SliverStats stats;
 };
 
@@ -189,13 +180,11 @@ absl::StatusOr<SliverResult> RemoveSlivers(const SliverInput& input, const Slive
 
 // The pipeline's form (core/api.cc): constrained faces as the output stage's
 // ConstrainedFace list, constrained edges as consecutive vertices of segment
-// chains (PointSetRefinement::segment_chains); `neighbor_slots` as
-// SliverInput's (PointSetRefinement::tet_neighbors; may be empty).
+// chains (PointSetRefinement::segment_chains).
 absl::StatusOr<SliverResult> RemoveSlivers(std::span<const geom::Vec3> positions,
                                            std::span<const std::array<uint32_t, 4>> tets,
                                            std::span<const ConstrainedFace> faces,
                                            std::span<const std::vector<uint32_t>> segment_chains,
-                                           const SliverOptions& options,
-                                           std::span<const uint32_t> neighbor_slots = {});
+                                           const SliverOptions& options);
 
 }  // namespace svrc::refine

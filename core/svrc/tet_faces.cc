@@ -106,39 +106,4 @@ bool TetFaces::Match(absl::FunctionRef<void(uint32_t, uint32_t)> pair, Overused*
   return true;
 }
 
-VertexTets::VertexTets(std::span<const std::array<uint32_t, 4>> tets, std::span<const uint8_t> needed,
-                       std::span<const uint8_t> alive)
-    : tets_(tets), start_(needed.size() + 1, 0) {
-  auto live = [&](size_t t) { return alive.empty() || alive[t] != 0; };
-  for (size_t t = 0; t < tets.size(); ++t) {
-    if (!live(t)) continue;
-    for (uint32_t v : tets[t]) start_[v + 1] += needed[v] != 0;
-  }
-  for (size_t v = 0; v < needed.size(); ++v) start_[v + 1] += start_[v];
-  star_.resize(start_.back());
-  std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
-  for (size_t t = 0; t < tets.size(); ++t) {
-    if (!live(t)) continue;
-    for (uint32_t v : tets[t]) {
-      if (needed[v] != 0) star_[fill[v]++] = static_cast<uint32_t>(t);
-    }
-  }
-}
-
-uint32_t VertexTets::FindFace(uint32_t a, uint32_t b, uint32_t c) const {
-  for (uint32_t t : Star(a)) {
-    const std::array<uint32_t, 4>& v = tets_[t];
-    int other = -1, found = 0;
-    for (int k = 0; k < 4; ++k) {
-      if (v[k] == a || v[k] == b || v[k] == c) {
-        ++found;
-      } else {
-        other = k;
-      }
-    }
-    if (found == 3 && other >= 0) return 4 * t + static_cast<uint32_t>(other);
-  }
-  return kNoSlot;
-}
-
 }  // namespace svrc::refine

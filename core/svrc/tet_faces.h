@@ -46,32 +46,4 @@ class TetFaces {
   std::vector<TetFace> faces_;
 };
 
-// The tets at each of a chosen set of vertices (a CSR table), for looking
-// up a few faces or edges of a tetrahedralization whose face adjacency is
-// already known, without the face table above: one pass over the tets, and
-// memory for the chosen vertices' stars only (the sliver pass and the output
-// labelling take their adjacency from the refiner's Delaunay3 and from the
-// flips, docs/svrc-design.md §8 item 52).
-class VertexTets {
- public:
-  // Star(v) of every v with needed[v] != 0 (needed.size() = the number of
-  // vertices, every vertex id of `tets` below it): its tets t with alive[t]
-  // (all, when `alive` is empty), in increasing order.
-  VertexTets(std::span<const std::array<uint32_t, 4>> tets, std::span<const uint8_t> needed,
-             std::span<const uint8_t> alive = {});
-  std::span<const uint32_t> Star(uint32_t v) const {
-    return {star_.data() + start_[v], star_.data() + start_[v + 1]};
-  }
-  // The slot 4t + f of the face {a, b, c} in the first tet t of Star(a)
-  // holding b and c (f: t's local index of its fourth vertex); kNoSlot if
-  // none. a must be a needed vertex.
-  static constexpr uint32_t kNoSlot = 0xFFFFFFFFu;
-  uint32_t FindFace(uint32_t a, uint32_t b, uint32_t c) const;
-
- private:
-  std::span<const std::array<uint32_t, 4>> tets_;
-  std::vector<uint32_t> start_;  // Star(v) = star_[start_[v], start_[v + 1])
-  std::vector<uint32_t> star_;
-};
-
 }  // namespace svrc::refine

@@ -10,7 +10,6 @@
 #include <optional>
 #include <map>
 #include <set>
-#include <span>
 #include <tuple>
 #include <string>
 #include <vector>
@@ -29,7 +28,6 @@
 #include "core/mesh/quality.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/sliver.h"
-#include "core/svrc/tet_faces.h"
 #include "gtest/gtest.h"
 #include "tests/test_support.h"
 
@@ -837,94 +835,6 @@ TEST(CollarRefine, SliverPassSkipsTheExteriorWithTheSameOutput) {
     std::printf("%s: %zu of %zu tets outside; sliver candidates %llu -> %llu\n", c.file, outside, run->tets.size(),
                 (unsigned long long)candidates[0], (unsigned long long)candidates[1]);
   }
-}
-
-// The face adjacency of `tets` from TetFaces (the face table the two passes
-// no longer build when they are given it): per slot the other tet's slot of
-// the same face, or kNoTet.
-std::vector<uint32_t> FaceTableAdjacency(std::span<const std::array<uint32_t, 4>> tets, size_t num_vertices) {
-  std::vector<uint32_t> out(4 * tets.size(), kNoTet);
-  TetFaces::Overused bad;
-  EXPECT_TRUE(TetFaces(tets, num_vertices).Match(
-      [&](uint32_t s, uint32_t t) {
-        out[s] = t;
-        out[t] = s;
-      },
-      &bad));
-  return out;
-}
-
-// PointSetRefinement::tet_neighbors (M_Ω's adjacency from Delaunay3) goes
-// into the sliver pass, and SliverResult::neighbor_slots (the flips') into
-// the output's labelling, so neither builds a face table (docs/svrc-design.md
-// §8 item 52). Each must be the adjacency of its tets (against TetFaces), and
-// the output mesh must be the one the face tables give, bit for bit: regions,
-// triangles and markers included. box_in_box has two regions with a max
-// volume; tiny_cube_in_box a spread. After RipStitchCollar (knife_edge.poly)
-// the tets are not M_Ω's and come without adjacency.
-TEST(CollarRefine, GivenAdjacencyGivesTheSameOutput) {
-  struct Case {
-    const char* file;
-    double max_volume;
-  };
-  for (const Case& c : {Case{"e_spread/tiny_cube_in_box.poly", 0}, Case{"b_internal/box_in_box.poly", 1e-3},
-                        Case{"b_internal/box_internal_facet.poly", 1e-3}}) {
-    SCOPED_TRACE(c.file);
-    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(c.file));
-    ASSERT_TRUE(plc.ok()) << plc.status();
-    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
-    ASSERT_TRUE(cx.ok()) << cx.status();
-    RefineOptions opt;
-    opt.max_volume = c.max_volume;
-    absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
-    ASSERT_TRUE(run.ok()) << run.status();
-    const size_t nv = run->normalised_positions.size();
-    EXPECT_EQ(run->tet_neighbors, FaceTableAdjacency(run->tets, nv));
-    const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
-    std::vector<mesh::TetMesh> meshes;
-    std::vector<std::vector<std::array<uint32_t, 4>>> flipped_tets;
-    for (int given = 0; given < 2; ++given) {
-      SliverOptions so;
-      so.skip_tet = run->tet_outside;
-      so.keep_max_volume = c.max_volume > 0;
-      absl::StatusOr<SliverResult> flipped =
-          RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so,
-                        given ? std::span<const uint32_t>(run->tet_neighbors) : std::span<const uint32_t>());
-      ASSERT_TRUE(flipped.ok()) << flipped.status();
-      EXPECT_GT(flipped->stats.flips(), 0u);
-      EXPECT_EQ(flipped->neighbor_slots, FaceTableAdjacency(flipped->tets, nv)) << "given " << given;
-      absl::StatusOr<OutputStageResult> out =
-          BuildOutputMesh(*plc, run->normalised_positions, flipped->tets, cx->point_of_vertex, faces,
-                          CoordinateMapOf(*run), false, nullptr,
-                          given ? std::span<const uint32_t>(flipped->neighbor_slots) : std::span<const uint32_t>());
-      ASSERT_TRUE(out.ok()) << out.status();
-      flipped_tets.push_back(flipped->tets);
-      meshes.push_back(std::move(out->mesh));
-    }
-    EXPECT_EQ(flipped_tets[0], flipped_tets[1]);
-    EXPECT_EQ(meshes[0].positions, meshes[1].positions);
-    EXPECT_EQ(meshes[0].tets, meshes[1].tets);
-    EXPECT_EQ(meshes[0].tet_region, meshes[1].tet_region);
-    EXPECT_EQ(meshes[0].triangles, meshes[1].triangles);
-    EXPECT_EQ(meshes[0].triangle_marker, meshes[1].triangle_marker);
-    ASSERT_EQ(meshes[0].regions.size(), meshes[1].regions.size());
-    for (size_t r = 0; r < meshes[0].regions.size(); ++r) {
-      EXPECT_EQ(meshes[0].regions[r].attribute, meshes[1].regions[r].attribute);
-    }
-    EXPECT_FALSE(meshes[1].triangles.empty());
-  }
-  absl::StatusOr<plc::Plc> knife = plc::ReadPlcFile(testing::CorpusPath("c_creases/knife_edge.poly"));
-  ASSERT_TRUE(knife.ok()) << knife.status();
-  absl::StatusOr<plc::FeatureComplex> kx = plc::BuildFeatureComplex(*knife);
-  ASSERT_TRUE(kx.ok()) << kx.status();
-  RefineOptions kopt;
-  kopt.collars = true;
-  kopt.collar_surface = true;
-  kopt.max_rep_angle = 60 * M_PI / 180;
-  absl::StatusOr<PointSetRefinement> stitched = RefinePlc(*kx, kopt);
-  ASSERT_TRUE(stitched.ok()) << stitched.status();
-  EXPECT_FALSE(stitched->collars.empty());
-  EXPECT_TRUE(stitched->tet_neighbors.empty());
 }
 
 // RefineOptions::reuse_round_work: the COLLAR rounds' per-ball restricted
