@@ -146,6 +146,8 @@ class Refiner {
   // once M_Ω is labelled (tet_quality); max_volume per tet too (set by the
   // first labelling when the regions' bounds differ, or RefineOptions::tet_sizes).
   bool skinny_deferred_ = false;
+  // RefineOptions::newest_first_tets.
+  void ServeSkinnyTetsNewestFirst() { queues_.SetNewestFirst(EventType::kSkinny, 3, true); }
   bool tet_mode_ = false;
   bool tet_sizes_ = false;
  private:
@@ -3790,6 +3792,8 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   const bool features_first = eligible && (tet_quality || options.features_first);
   if (features_first) refiner.skinny_deferred_ = true;
   refiner.tet_mode_ = tet_quality;
+  // Skinny₃ buckets newest first (docs/svrc-design.md §8 item 52).
+  if (tet_quality && options.newest_first_tets) refiner.ServeSkinnyTetsNewestFirst();
 
   s = refiner.Run();
   if (!s.ok()) return s;

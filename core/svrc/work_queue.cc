@@ -121,6 +121,10 @@ void WorkQueues::Free(uint32_t e) {
   free_head_ = e;
 }
 
+void WorkQueues::SetNewestFirst(EventType type, int dim, bool newest_first) {
+  queues_[QueueIndex(type, dim)].newest_first = newest_first;
+}
+
 uint32_t WorkQueues::PopFrom(int q) {
   Queue& queue = queues_[q];
   if (queue_size_[q] == 0) {
@@ -137,7 +141,7 @@ uint32_t WorkQueues::PopFrom(int q) {
   stats_.buckets_walked += walked;
   stats_.max_walk_one_op = std::max(stats_.max_walk_one_op, walked);
   assert(queue.cursor >= 0);
-  const uint32_t e = queue.Head(queue.cursor);
+  const uint32_t e = queue.newest_first ? queue.Tail(queue.cursor) : queue.Head(queue.cursor);
   Unlink(e);
   return e;
 }

@@ -3,7 +3,9 @@
 // Unresolved₁₋₃, Collar₁₋₃ — scanned in the priority order of Dequeue.
 //
 // Inside one queue, events are bucketed by ⌊log₂ r⌋ (ilogb), the largest bucket is
-// served first, and a bucket is FIFO (push order) so runs are deterministic.
+// served first, and a bucket is FIFO (push order) or, per queue on request,
+// LIFO (newest first); either way runs are deterministic. The thesis fixes the
+// order of buckets, not the order inside one (§5.1.2).
 // Events are keys (mesh, object, generation), not balls: whoever pops an event
 // decides whether it is stale (lazy deletion, as Triangle's bad-triangle queue
 // and Th. Figure 3.4 line 1 "no longer on the Voronoi skeleton").
@@ -72,13 +74,21 @@ class WorkQueues {
 
   WorkQueues();
 
+  // Serves the buckets of queue (type, dim) newest event first (LIFO) instead
+  // of oldest first. A refinement's newest events lie next to its latest
+  // insertion, whose cells and tets are still in cache (docs/svrc-design.md §8
+  // item 52). Takes effect at the next pop.
+  void SetNewestFirst(EventType type, int dim, bool newest_first);
+  bool NewestFirst(EventType type, int dim) const { return queues_[QueueIndex(type, dim)].newest_first; }
+
   // Push. Returns an invalid handle (and counts `rejected`) for an event that
   // has no queue: Encroached with dim ∉ {1,2}, Collar₁, dim ∉ {1,2,3}, or a
   // radius that is negative or not finite.
   EventHandle Enqueue(const WorkEvent& event);
 
   // Pops the highest-priority event (first non-empty queue in PriorityOrder,
-  // largest bucket, oldest in the bucket). nullopt when all are empty.
+  // largest bucket, oldest in the bucket — newest in a NewestFirst queue).
+  // nullopt when all are empty.
   std::optional<WorkEvent> Dequeue();
 
   // Pops events until one is live according to `is_live`; the others are
@@ -148,6 +158,7 @@ class WorkQueues {
     // Per chunk: heads of its buckets in [0, kChunk), tails in [kChunk, 2·kChunk).
     std::array<std::unique_ptr<uint32_t[]>, kNumChunks> chunks;
     int cursor = -1;  // no non-empty bucket above it
+    bool newest_first = false;  // pop a bucket's tail instead of its head
     uint32_t Head(int b) const {
       const uint32_t* c = chunks[b / kChunk].get();
       return c == nullptr ? kNil : c[b % kChunk];

@@ -707,9 +707,12 @@ TEST(CollarRefine, VolumeTestMeetsTheBoundWithFewerTets) {
     double max_ratio;   // tets with the volume test / with the circumradius test
   };
   for (const Case& c : {Case{"a_convex/cube.poly", 1e-3, 0.9}, Case{"b_internal/box_in_box.poly", 2e-4, 0.9},
-                        Case{"nested", 0, 1.0}}) {
+                        Case{"nested", 0, 1.03}}) {
     // nested: three regions with max volumes 1e-2, 1.25e-3, 1.5625e-4; its
-    // small boxes' radius-edge and grading set most sizes (1,179 → 1,159).
+    // small boxes' radius-edge and grading set most sizes, so the two tests
+    // give about as many tets and the event order decides the rest: 1,179 →
+    // 1,159 with FIFO Skinny₃ buckets, 1,210 → 1,222 newest first (design §8
+    // item 52). Bounded at +3%: not more tets than that for the exact bound.
     absl::StatusOr<plc::Plc> plc = CaseInput(c.file);
     ASSERT_TRUE(plc.ok()) << plc.status();
     absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
@@ -740,6 +743,56 @@ TEST(CollarRefine, VolumeTestMeetsTheBoundWithFewerTets) {
     }
     EXPECT_LT(static_cast<double>(tets[1]), c.max_ratio * static_cast<double>(tets[0])) << c.file;
     std::printf("%s: %zu tets with the circumradius test, %zu with the volume test\n", c.file, tets[0], tets[1]);
+  }
+}
+
+// RefineOptions::newest_first_tets (docs/svrc-design.md §8 item 52): under
+// per-tet quality the Skinny₃ buckets are served newest first. The order
+// inside a bucket is free (the thesis orders buckets), so either order must
+// give a conforming mesh meeting radius-edge 2 and every region's volume
+// bound, with the location graph's invariants checked along the way; the
+// outputs differ (the option takes effect) and their tet counts stay within
+// 10% of each other (measured, M_Ω's tets with the exterior: 12,963 →
+// 13,440 on box_in_box 2e-4, 2,152 → 2,241 on nested; output tets on 46
+// bench rows: geometric mean ×0.974).
+TEST(CollarRefine, NewestFirstSkinnyTetsGiveAValidMeshEitherWay) {
+  struct Case {
+    const char* file;
+    double max_volume;
+  };
+  for (const Case& c : {Case{"b_internal/box_in_box.poly", 2e-4}, Case{"nested", 0}}) {
+    absl::StatusOr<plc::Plc> plc = CaseInput(c.file);
+    ASSERT_TRUE(plc.ok()) << plc.status();
+    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+    ASSERT_TRUE(cx.ok()) << cx.status();
+    std::vector<std::array<uint32_t, 4>> tets[2];
+    for (int newest = 0; newest < 2; ++newest) {
+      RefineOptions opt;
+      opt.max_volume = c.max_volume;
+      opt.newest_first_tets = newest == 1;
+      opt.validate_every = kSanitized ? 0 : 128;
+      const std::string what = absl::StrCat(c.file, " newest_first ", newest);
+      const std::optional<RefinedMesh> r = RefineAndCheck(*plc, *cx, opt, what);
+      ASSERT_TRUE(r.has_value()) << what;
+      const mesh::TetMesh& m = r->mesh;
+      size_t over = 0;
+      for (size_t t = 0; t < m.tets.size(); ++t) {
+        double bound = c.max_volume > 0 ? c.max_volume : HUGE_VAL;
+        const double region = m.regions[m.tet_region[t]].max_volume;
+        if (region > 0) bound = std::min(bound, region);
+        const geom::Vec3 a = m.positions[m.tets[t][0]];
+        const double vol = geom::Dot(m.positions[m.tets[t][1]] - a,
+                                     geom::Cross(m.positions[m.tets[t][2]] - a, m.positions[m.tets[t][3]] - a)) / 6;
+        over += vol > bound;
+      }
+      EXPECT_EQ(over, 0u) << what << ": tets above their region's bound";
+      tets[newest] = r->run.tets;
+    }
+    EXPECT_NE(tets[0], tets[1]) << c.file << ": the option changed nothing";
+    const double ratio = static_cast<double>(tets[1].size()) / static_cast<double>(tets[0].size());
+    EXPECT_GT(ratio, 0.9) << c.file;
+    EXPECT_LT(ratio, 1.1) << c.file;
+    std::printf("%s: %zu refinement tets oldest first, %zu newest first\n", c.file, tets[0].size(), tets[1].size());
   }
 }
 

@@ -83,6 +83,38 @@ TEST(WorkQueueTest, LargestBucketFirstFifoInsideBucket) {
   EXPECT_EQ(order, (std::vector<uint32_t>{2, 5, 1, 3, 6, 4}));
 }
 
+// SetNewestFirst: the same buckets, largest first, but a bucket of that queue
+// is served newest first (LIFO); the other queues stay FIFO. An event moved by
+// DecreaseSize is the newest of its new bucket.
+TEST(WorkQueueTest, NewestFirstQueueIsLifoInsideBucket) {
+  WorkQueues q;
+  q.SetNewestFirst(EventType::kSkinny, 3, true);
+  EXPECT_TRUE(q.NewestFirst(EventType::kSkinny, 3));
+  EXPECT_FALSE(q.NewestFirst(EventType::kSkinny, 2));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 1.0, 1));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 8.5, 2));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 1.9, 3));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 0.25, 4));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 15.9, 5));
+  const EventHandle h = q.Enqueue(Ev(EventType::kSkinny, 3, 9.0, 6));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 1.5, 7));
+  q.DecreaseSize(h, 1.2);  // 6 leaves bucket 3 for bucket 0, after 7
+  // A FIFO queue of lower priority, pushed in the same order.
+  q.Enqueue(Ev(EventType::kUnresolved, 3, 1.0, 11));
+  q.Enqueue(Ev(EventType::kUnresolved, 3, 1.9, 13));
+  q.Enqueue(Ev(EventType::kUnresolved, 3, 1.5, 17));
+  ASSERT_TRUE(q.Validate());
+  std::vector<uint32_t> order;
+  while (auto e = q.Dequeue()) order.push_back(e->object);
+  EXPECT_EQ(order, (std::vector<uint32_t>{5, 2, 6, 7, 3, 1, 4, 11, 13, 17}));
+  // Switched back: FIFO again.
+  q.SetNewestFirst(EventType::kSkinny, 3, false);
+  q.Enqueue(Ev(EventType::kSkinny, 3, 1.0, 21));
+  q.Enqueue(Ev(EventType::kSkinny, 3, 1.5, 22));
+  EXPECT_EQ(q.Dequeue()->object, 21u);
+  EXPECT_EQ(q.Dequeue()->object, 22u);
+}
+
 TEST(WorkQueueTest, StaleEventsDroppedOnPopAndCounted) {
   WorkQueues q;
   std::vector<uint32_t> generation = {0, 0, 0, 0};
