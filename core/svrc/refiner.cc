@@ -3040,9 +3040,18 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   if (size_target_.size() < nv) size_target_.resize(nv, HUGE_VAL);
   cell_cert_.clear();  // certificates read the size targets
   std::vector<uint8_t> touched(nv, 0);
-  // Per-tet targets for PropagateSizeTargets, on M_Ω's own tets only.
-  tet_labels_.clear();
-  if (!tet_ids.empty() && options_.propagate_size_targets) tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  // Per-tet targets for PropagateSizeTargets, on M_Ω's own tets only. The
+  // labels are rewritten in place: each live finite tet's old label is read
+  // before its new one is written (below), and every other slot is reset
+  // afterwards, as if the array had been cleared.
+  const bool relabel = !tet_ids.empty() && options_.propagate_size_targets;
+  const size_t old_labels = relabel && options_.skip_unchanged_tets ? tet_labels_.size() : 0;
+  if (!relabel) tet_labels_.clear();
+  if (relabel) tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  const bool sizes_before = tet_sizes_;
+  // Per tet of tet_ids: its label is the one it was tested with when made
+  // (or at the last labelling), so EnqueueTetIfBad would find it good.
+  std::vector<uint8_t> unchanged(old_labels > 0 ? tets.size() : 0, 0);
   // Cells are sized on the output's tets from now on (item 33); the memos
   // of Size() drop.
   omega_.SetLabels(!tet_labels_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_labels_ : nullptr);
@@ -3072,16 +3081,22 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const bool bounded = !uniform || (first_volume >= 0 && first_volume != HUGE_VAL);
   if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
+    const bool kept = lab->Kept(static_cast<uint32_t>(t));
+    const double rt = kept && tet_volume[t] != HUGE_VAL
+                          ? std::cbrt(6.0 * std::sqrt(2.0) * tet_volume[t]) * std::sqrt(6.0) / 4.0
+                          : HUGE_VAL;
     if (!tet_labels_.empty()) {
-      tet_labels_[tet_ids[t].value()] = {dt.Generation(tet_ids[t]) + 1, lab->Kept(static_cast<uint32_t>(t)), false, HUGE_VAL};
+      const uint32_t slot = tet_ids[t].value();
+      const TetLabel fresh{dt.Generation(tet_ids[t]) + 1, kept, false, rt, kept ? tet_volume[t] : HUGE_VAL};
+      if (slot < old_labels) {
+        const TetLabel& old = tet_labels_[slot];
+        unchanged[t] = old.gen == fresh.gen && old.kept == fresh.kept && old.target == fresh.target &&
+                       old.volume == fresh.volume;
+      }
+      tet_labels_[slot] = fresh;
     }
-    if (!lab->Kept(static_cast<uint32_t>(t))) continue;
+    if (!kept) continue;
     if (tet_volume[t] == HUGE_VAL) continue;
-    const double rt = std::cbrt(6.0 * std::sqrt(2.0) * tet_volume[t]) * std::sqrt(6.0) / 4.0;
-    if (!tet_labels_.empty()) {
-      tet_labels_[tet_ids[t].value()].target = rt;
-      tet_labels_[tet_ids[t].value()].volume = tet_volume[t];
-    }
     if (tet_sizes_) continue;
     for (uint32_t v : tets[t]) {
       if (rt < size_target_[v]) {
@@ -3090,9 +3105,28 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       }
     }
   }
+  if (relabel) {
+    // The slots of dead and ghost tets hold no label (a stale one would pass
+    // PropagateSizeTargets' generation test as its cavity's).
+    for (uint32_t i = 0; i < tet_labels_.size(); ++i) {
+      const TetId t(i);
+      if (i >= dt.TetCapacity() || !dt.IsAlive(t) || dt.IsGhost(t)) tet_labels_[i] = TetLabel{};
+    }
+  }
   bool any = false;
   if (tet_mode_) {
-    for (TetId t : tet_ids) any = EnqueueTetIfBad(t) || any;
+    // A tet keeping the label it was tested with was good then (a bad one
+    // was enqueued, and Destroy removes it: it warps within θr of the
+    // circumcentre or inserts it) and TetBad reads only the tet, its label
+    // and tet_sizes_: it is good now unless tet_sizes_ just changed.
+    const bool retest_all = tet_sizes_ != sizes_before;
+    for (size_t t = 0; t < tet_ids.size(); ++t) {
+      if (!retest_all && !unchanged.empty() && unchanged[t]) {
+        ++stats_.labels_unchanged;
+        continue;
+      }
+      any = EnqueueTetIfBad(tet_ids[t]) || any;
+    }
   }
   for (uint32_t v = 0; v < nv; ++v) {
     if (!touched[v] && !all_vertices) continue;
@@ -3612,6 +3646,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   }
   out->Set("svrc.buckets_walked", static_cast<double>(buckets_walked));
   out->Set("svrc.size_rounds", static_cast<double>(size_rounds));
+  out->Set("svrc.labels_unchanged", static_cast<double>(labels_unchanged));
   out->Set("svrc.flat_tets_broken", static_cast<double>(flat_tets_broken));
   out->Set("svrc.slivers_broken", static_cast<double>(slivers_broken));
   out->Set("svrc.sliver_scan_reused", static_cast<double>(sliver_scan_reused));

@@ -86,6 +86,10 @@ struct RefineOptions {
   // time, −0.9% tets; peak memory +10–15% (stale events wait longer at the
   // bottom of a bucket). false: oldest first, as the collar path always is.
   bool newest_first_tets = true;
+  // With tet_quality, a size round tests only the tets whose label it
+  // changed (a tet keeping its label was tested with it when made; docs/
+  // svrc-design.md §8 item 53; the same output). false: every tet (tests).
+  bool skip_unchanged_tets = true;
   // Destroy in M_Ω gathers every ball of every cell it visits (Figure 3.4
   // line 3) instead of v's balls and the other cells' unresolved 0-balls
   // only (the same choices: docs/svrc-design.md §8 item 36). Tests.
@@ -277,6 +281,7 @@ struct RefineStats {
   uint64_t tied_balls = 0;         // pieces/triangles missing at the end (ties), re-enqueued
   uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first
   uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run
+  uint64_t labels_unchanged = 0;   // tets a size round relabelled as they were: not retested
   uint64_t collars = 0;            // collar balls created (stage (d))
   uint64_t vertex_collars = 0;     // of those, centred on an input vertex
   uint64_t collars_skipped_inside = 0;  // crease points strictly inside a collar: no ball

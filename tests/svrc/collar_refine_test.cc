@@ -916,6 +916,26 @@ TEST(CollarRefine, ReusedRoundWorkGivesTheSameRefinement) {
   }
 }
 
+// RefineOptions::skip_unchanged_tets (docs/svrc-design.md §8 item 53): a
+// size round tests only the tets whose label it changed, and gives the same
+// refinement as testing every tet; with validate_every the final invariant
+// check finds no bad tet left. cube: one region; box_in_box and
+// box_internal_facet: two kept regions on either side of internal facets.
+TEST(CollarRefine, SizeRoundsSkippingUnchangedLabelsGiveTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_in_box.poly", false, 2e-4},
+        SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
+      o->skip_unchanged_tets = on;
+      o->validate_every = kSanitized ? 0 : 512;
+    });
+    EXPECT_EQ(runs[0].stats.labels_unchanged, 0u) << c.rel;
+    // Most tets keep their propagated label through the confirming round.
+    EXPECT_GT(runs[1].stats.labels_unchanged, runs[1].tets.size() / 2) << c.rel;
+    EXPECT_EQ(runs[0].stats.size_rounds, runs[1].stats.size_rounds) << c.rel;
+  }
+}
+
 // Cancellation and deadlines are polled inside the COLLAR rounds too, every
 // poll_interval repairs, with a progress report each time: a round can
 // insert tens of thousands of points (fandisk.off: a 900 s deadline ended
