@@ -21,6 +21,13 @@ WorkEvent Ev(EventType type, int dim, double r, uint32_t object = 0, uint32_t ge
   return e;
 }
 
+// Pops every event; their objects in pop order.
+std::vector<uint32_t> Drain(WorkQueues& q) {
+  std::vector<uint32_t> order;
+  while (auto e = q.Dequeue()) order.push_back(e->object);
+  return order;
+}
+
 TEST(WorkQueueTest, BucketIsFloorLog2) {
   EXPECT_EQ(WorkQueues::BucketOf(1.0) + WorkQueues::kMinExp, 0);
   EXPECT_EQ(WorkQueues::BucketOf(1.999) + WorkQueues::kMinExp, 0);
@@ -50,9 +57,7 @@ TEST(WorkQueueTest, GlobalPriorityOrder) {
   q.Enqueue(Ev(T::kUnresolved, 2, 1e9, 9));
   q.Enqueue(Ev(T::kSkinny, 2, 1e9, 10));
   ASSERT_TRUE(q.Validate());
-  std::vector<uint32_t> order;
-  while (auto e = q.Dequeue()) order.push_back(e->object);
-  EXPECT_EQ(order, (std::vector<uint32_t>{7, 10, 3, 8, 4, 6, 9, 2, 5, 1}));
+  EXPECT_EQ(Drain(q), (std::vector<uint32_t>{7, 10, 3, 8, 4, 6, 9, 2, 5, 1}));
   EXPECT_TRUE(q.empty());
 }
 
@@ -78,9 +83,7 @@ TEST(WorkQueueTest, LargestBucketFirstFifoInsideBucket) {
   q.Enqueue(Ev(EventType::kSkinny, 3, 0.25, 4));
   q.Enqueue(Ev(EventType::kSkinny, 3, 15.9, 5));  // same bucket as 8.5: after it
   q.Enqueue(Ev(EventType::kSkinny, 3, 1.5, 6));
-  std::vector<uint32_t> order;
-  while (auto e = q.Dequeue()) order.push_back(e->object);
-  EXPECT_EQ(order, (std::vector<uint32_t>{2, 5, 1, 3, 6, 4}));
+  EXPECT_EQ(Drain(q), (std::vector<uint32_t>{2, 5, 1, 3, 6, 4}));
 }
 
 // SetNewestFirst: the same buckets, largest first, but a bucket of that queue
@@ -104,9 +107,7 @@ TEST(WorkQueueTest, NewestFirstQueueIsLifoInsideBucket) {
   q.Enqueue(Ev(EventType::kUnresolved, 3, 1.9, 13));
   q.Enqueue(Ev(EventType::kUnresolved, 3, 1.5, 17));
   ASSERT_TRUE(q.Validate());
-  std::vector<uint32_t> order;
-  while (auto e = q.Dequeue()) order.push_back(e->object);
-  EXPECT_EQ(order, (std::vector<uint32_t>{5, 2, 6, 7, 3, 1, 4, 11, 13, 17}));
+  EXPECT_EQ(Drain(q), (std::vector<uint32_t>{5, 2, 6, 7, 3, 1, 4, 11, 13, 17}));
   // Switched back: FIFO again.
   q.SetNewestFirst(EventType::kSkinny, 3, false);
   q.Enqueue(Ev(EventType::kSkinny, 3, 1.0, 21));
