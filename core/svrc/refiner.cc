@@ -2945,6 +2945,9 @@ absl::Status Refiner::CheckInvariants(bool final) {
 absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex, double global_max_volume,
                                              bool all_vertices) {
   const AddSeconds timer(&stats_.seconds_labelling);
+  // The labelling's arrays are the run's peak (massif, cube 1e-5): the event
+  // slots of the Run() before it, all free now, go first (§8 item 52).
+  if (queues_.ReleaseIfEmpty()) ++stats_.queue_releases;
   const delaunay::Delaunay3& dt = omega_.dt();
   const uint32_t nv = dt.NumVertices();
   std::vector<Vec3> positions(nv);
@@ -3646,6 +3649,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   }
   out->Set("svrc.buckets_walked", static_cast<double>(buckets_walked));
   out->Set("svrc.size_rounds", static_cast<double>(size_rounds));
+  out->Set("svrc.queue_releases", static_cast<double>(queue_releases));
   out->Set("svrc.labels_unchanged", static_cast<double>(labels_unchanged));
   out->Set("svrc.flat_tets_broken", static_cast<double>(flat_tets_broken));
   out->Set("svrc.slivers_broken", static_cast<double>(slivers_broken));

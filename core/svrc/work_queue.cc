@@ -62,6 +62,7 @@ EventHandle WorkQueues::Enqueue(const WorkEvent& event) {
     e = static_cast<uint32_t>(entries_.size());
     util::ReserveForAppend(entries_);
     entries_.emplace_back();
+    entries_.back().generation = first_generation_;
   }
   Entry& entry = entries_[e];
   entry.event = event;
@@ -166,6 +167,14 @@ std::optional<WorkEvent> WorkQueues::DequeueLive(
     if (is_live(*event)) return event;
     ++stats_.stale[static_cast<int>(event->type)];
   }
+}
+
+bool WorkQueues::ReleaseIfEmpty() {
+  if (size_ != 0 || entries_.capacity() == 0) return false;
+  for (const Entry& entry : entries_) first_generation_ = std::max(first_generation_, entry.generation + 1);
+  std::vector<Entry>().swap(entries_);
+  free_head_ = kNil;
+  return true;
 }
 
 bool WorkQueues::IsQueued(EventHandle handle) const {

@@ -116,6 +116,38 @@ TEST(WorkQueueTest, NewestFirstQueueIsLifoInsideBucket) {
   EXPECT_EQ(q.Dequeue()->object, 22u);
 }
 
+// ReleaseIfEmpty frees the event slots only when nothing is queued, and a
+// handle from before never matches an event made after (the slots restart
+// at a generation above every one handed out).
+TEST(WorkQueueTest, ReleaseIfEmptyKeepsOldHandlesStale) {
+  WorkQueues q;
+  std::vector<EventHandle> old;
+  for (uint32_t i = 0; i < 100; ++i) old.push_back(q.Enqueue(Ev(EventType::kSkinny, 3, 1.0 + i, i)));
+  q.Remove(old[5]);
+  EXPECT_FALSE(q.ReleaseIfEmpty());  // 99 queued
+  EXPECT_TRUE(q.IsQueued(old[6]));
+  while (q.Dequeue()) {
+  }
+  EXPECT_GE(q.SlotCapacity(), 100u);
+  EXPECT_TRUE(q.ReleaseIfEmpty());
+  EXPECT_EQ(q.SlotCapacity(), 0u);
+  EXPECT_FALSE(q.ReleaseIfEmpty());  // nothing left to free
+  // The same slots again, a few pushed and popped twice over.
+  std::vector<EventHandle> fresh;
+  for (uint32_t i = 0; i < 100; ++i) fresh.push_back(q.Enqueue(Ev(EventType::kUnresolved, 3, 2.0, 1000 + i)));
+  for (const EventHandle& h : old) {
+    EXPECT_FALSE(q.IsQueued(h));
+    q.Remove(h);                     // a no-op on a stale handle
+    q.DecreaseSize(h, 0.001);        // likewise
+  }
+  ASSERT_TRUE(q.Validate());
+  EXPECT_EQ(q.size(), 100u);
+  for (const EventHandle& h : fresh) EXPECT_TRUE(q.IsQueued(h));
+  std::vector<uint32_t> order = Drain(q);
+  ASSERT_EQ(order.size(), 100u);
+  for (uint32_t i = 0; i < 100; ++i) EXPECT_EQ(order[i], 1000 + i);  // FIFO, none moved or removed
+}
+
 TEST(WorkQueueTest, StaleEventsDroppedOnPopAndCounted) {
   WorkQueues q;
   std::vector<uint32_t> generation = {0, 0, 0, 0};
