@@ -185,6 +185,14 @@ inline uint32_t LocationGraph::CellPos(const Span& cs, LocationObject object) co
   return kNil;
 }
 
+inline uint32_t LocationGraph::ObjectPosFromBack(const Span& os, MeshId mesh, uint32_t cell) const {
+  const ObjectEntry* e = object_arena_.Data(os);
+  for (uint32_t i = os.size; i-- > 0;) {
+    if (e[i].cell == cell && e[i].mesh == mesh.value()) return i;
+  }
+  return kNil;
+}
+
 inline uint32_t LocationGraph::ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const {
   const ObjectEntry* e = object_arena_.Data(os);
   for (uint32_t i = 0; i < os.size; ++i) {
@@ -296,7 +304,7 @@ void LocationGraph::RemoveCellLinksWhere(MeshId mesh, uint32_t cell, const std::
     }
     const LocationObject object = e[i].object();
     Span& os = ObjectSpan(object);
-    object_arena_.Erase(os, ObjectPos(os, mesh, cell));
+    object_arena_.Erase(os, ObjectPosFromBack(os, mesh, cell));
     if (e[i].unresolved() && --cs.unresolved == 0) LeaveUnresolved(mesh, cs);
   }
   num_links_ -= cs.size - kept;

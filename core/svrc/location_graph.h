@@ -225,6 +225,11 @@ class LocationGraph {
   // object's array; kNil when absent.
   uint32_t CellPos(const Span& cs, LocationObject object) const;
   uint32_t ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const;
+  // The same position, searched from the back: a shrunk cell's links to a
+  // ball go in the ball's newer cells more often (cube 1e-5:
+  // RemoveCellLinksWhere 175 M → 131 M instructions). A (mesh, cell) pair is
+  // in an object's list at most once, so both find the same entry.
+  uint32_t ObjectPosFromBack(const Span& os, MeshId mesh, uint32_t cell) const;
   // Removes entry `oi` of the object's array and entry `ci` of the cell's
   // array, which must be the same link.
   void RemoveAt(MeshId mesh, CellSpanT& cs, uint32_t ci, Span& os, uint32_t oi);
