@@ -227,7 +227,7 @@ class LocationGraph {
   uint32_t ObjectPos(const Span& os, MeshId mesh, uint32_t cell) const;
   // The same position, searched from the back: a shrunk cell's links to a
   // ball go in the ball's newer cells more often (cube 1e-5:
-  // RemoveCellLinksWhere 175 M → 131 M instructions). A (mesh, cell) pair is
+  // RemoveCellLinksWhere 175 M → 131 M instructions; design §8 item 54). A (mesh, cell) pair is
   // in an object's list at most once, so both find the same entry.
   uint32_t ObjectPosFromBack(const Span& os, MeshId mesh, uint32_t cell) const;
   // Removes entry `oi` of the object's array and entry `ci` of the cell's
