@@ -3095,6 +3095,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
         const TetLabel& old = tet_labels_[slot];
         unchanged[t] = old.gen == fresh.gen && old.kept == fresh.kept && old.target == fresh.target &&
                        old.volume == fresh.volume;
+        stats_.labels_changed += unchanged[t] == 0;
       }
       tet_labels_[slot] = fresh;
     }
@@ -3651,6 +3652,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.size_rounds", static_cast<double>(size_rounds));
   out->Set("svrc.queue_releases", static_cast<double>(queue_releases));
   out->Set("svrc.labels_unchanged", static_cast<double>(labels_unchanged));
+  out->Set("svrc.labels_changed", static_cast<double>(labels_changed));
   out->Set("svrc.flat_tets_broken", static_cast<double>(flat_tets_broken));
   out->Set("svrc.slivers_broken", static_cast<double>(slivers_broken));
   out->Set("svrc.sliver_scan_reused", static_cast<double>(sliver_scan_reused));

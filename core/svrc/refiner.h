@@ -282,6 +282,7 @@ struct RefineStats {
   uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first
   uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run
   uint64_t labels_unchanged = 0;   // tets a size round relabelled as they were: not retested
+  uint64_t labels_changed = 0;     // tets whose propagated label a size round corrected (retested)
   uint64_t queue_releases = 0;     // times the empty work queues gave back their event slots
   uint64_t collars = 0;            // collar balls created (stage (d))
   uint64_t vertex_collars = 0;     // of those, centred on an input vertex
