@@ -3049,8 +3049,11 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // afterwards, as if the array had been cleared.
   const bool relabel = !tet_ids.empty() && options_.propagate_size_targets;
   const size_t old_labels = relabel && options_.skip_unchanged_tets ? tet_labels_.size() : 0;
-  if (!relabel) tet_labels_.clear();
-  if (relabel) tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  if (relabel) {
+    tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+  } else {
+    tet_labels_.clear();
+  }
   const bool sizes_before = tet_sizes_;
   // Per tet of tet_ids: its label is the one it was tested with when made
   // (or at the last labelling), so EnqueueTetIfBad would find it good.

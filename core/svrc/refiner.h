@@ -82,9 +82,11 @@ struct RefineOptions {
   // event first (LIFO) instead of oldest first: the newest bad tets lie at the
   // latest insertion, whose tets, cells and links are still in cache. The
   // thesis orders the buckets, not the events inside one (§5.1.2). Measured
-  // (docs/svrc-design.md §8 item 52): cube max_volume 1e-5 refinement −17%
-  // time, −0.9% tets; peak memory +10–15% (stale events wait longer at the
-  // bottom of a bucket). false: oldest first, as the collar path always is.
+  // (docs/svrc-design.md §8 item 52): cube max_volume 1e-5 refinement −16%
+  // time on the huge-page heap, −0.9% tets. Stale events wait longer at the
+  // bottom of a bucket (the queue peaks twice as high); WorkQueues::
+  // ReleaseIfEmpty keeps that out of the labelling's peak. false: oldest
+  // first, as the collar path always is.
   bool newest_first_tets = true;
   // With tet_quality, a size round tests only the tets whose label it
   // changed (a tet keeping its label was tested with it when made; docs/

@@ -529,6 +529,24 @@ absl::StatusOr<plc::Plc> CaseInput(const std::string& file) {
   return plc::ReadPlcFile(testing::CorpusPath(file));
 }
 
+// The output tets whose volume exceeds their bound: the smaller of
+// `max_volume` (≤ 0: none) and their region's max volume. nullopt when a tet
+// has neither.
+std::optional<size_t> TetsAboveTheirBound(const mesh::TetMesh& m, double max_volume) {
+  size_t over = 0;
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    double bound = max_volume > 0 ? max_volume : HUGE_VAL;
+    const double region = m.regions[m.tet_region[t]].max_volume;
+    if (region > 0) bound = std::min(bound, region);
+    if (bound == HUGE_VAL) return std::nullopt;
+    const geom::Vec3 a = m.positions[m.tets[t][0]];
+    const double vol = geom::Dot(m.positions[m.tets[t][1]] - a,
+                                 geom::Cross(m.positions[m.tets[t][2]] - a, m.positions[m.tets[t][3]] - a)) / 6;
+    over += vol > bound;
+  }
+  return over;
+}
+
 // RefinePlc(cx, opt) and its output mesh, checked: conforming, radius-edge
 // ≤ 2 on every tet. nullopt (with a failure) when a stage fails.
 struct RefinedMesh {
@@ -727,18 +745,9 @@ TEST(CollarRefine, VolumeTestMeetsTheBoundWithFewerTets) {
       ASSERT_TRUE(r.has_value());
       const mesh::TetMesh& m = r->mesh;
       ASSERT_EQ(m.tet_region.size(), m.tets.size()) << c.file;
-      size_t over = 0;
-      for (size_t t = 0; t < m.tets.size(); ++t) {
-        double bound = c.max_volume > 0 ? c.max_volume : HUGE_VAL;
-        const double region = m.regions[m.tet_region[t]].max_volume;
-        if (region > 0) bound = std::min(bound, region);
-        ASSERT_LT(bound, HUGE_VAL) << c.file << " tet " << t;
-        const geom::Vec3 a = m.positions[m.tets[t][0]];
-        const double vol = geom::Dot(m.positions[m.tets[t][1]] - a,
-                                     geom::Cross(m.positions[m.tets[t][2]] - a, m.positions[m.tets[t][3]] - a)) / 6;
-        over += vol > bound;
-      }
-      EXPECT_EQ(over, 0u) << c.file << " volumes " << volumes << ": tets above their region's bound";
+      const std::optional<size_t> over = TetsAboveTheirBound(m, c.max_volume);
+      ASSERT_TRUE(over.has_value()) << c.file << ": a tet without a volume bound";
+      EXPECT_EQ(*over, 0u) << c.file << " volumes " << volumes << ": tets above their region's bound";
       tets[volumes] = m.tets.size();
     }
     EXPECT_LT(static_cast<double>(tets[1]), c.max_ratio * static_cast<double>(tets[0])) << c.file;
@@ -774,18 +783,9 @@ TEST(CollarRefine, NewestFirstSkinnyTetsGiveAValidMeshEitherWay) {
       const std::string what = absl::StrCat(c.file, " newest_first ", newest);
       const std::optional<RefinedMesh> r = RefineAndCheck(*plc, *cx, opt, what);
       ASSERT_TRUE(r.has_value()) << what;
-      const mesh::TetMesh& m = r->mesh;
-      size_t over = 0;
-      for (size_t t = 0; t < m.tets.size(); ++t) {
-        double bound = c.max_volume > 0 ? c.max_volume : HUGE_VAL;
-        const double region = m.regions[m.tet_region[t]].max_volume;
-        if (region > 0) bound = std::min(bound, region);
-        const geom::Vec3 a = m.positions[m.tets[t][0]];
-        const double vol = geom::Dot(m.positions[m.tets[t][1]] - a,
-                                     geom::Cross(m.positions[m.tets[t][2]] - a, m.positions[m.tets[t][3]] - a)) / 6;
-        over += vol > bound;
-      }
-      EXPECT_EQ(over, 0u) << what << ": tets above their region's bound";
+      const std::optional<size_t> over = TetsAboveTheirBound(r->mesh, c.max_volume);
+      ASSERT_TRUE(over.has_value()) << what << ": a tet without a volume bound";
+      EXPECT_EQ(*over, 0u) << what << ": tets above their region's bound";
       tets[newest] = r->run.tets;
     }
     EXPECT_NE(tets[0], tets[1]) << c.file << ": the option changed nothing";
