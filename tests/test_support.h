@@ -14,7 +14,9 @@ std::string CorpusPath(const std::string& relative);
 // Whole file as bytes; fails the current test if it cannot be read.
 std::string ReadFileOrFail(const std::string& path);
 
-// A fresh empty directory under the test temp dir, unique per call.
+// A fresh empty directory under the test temp dir, unique per call. After
+// the process's last test it is removed with the "<dir>.<n>.log" files beside
+// it, unless a test failed or SVRC_KEEP_TEST_DIRS=1.
 std::string MakeTempDir(const std::string& tag);
 
 }  // namespace svrc::testing
