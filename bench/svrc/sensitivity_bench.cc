@@ -241,19 +241,27 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
     absl::StatusOr<mesh::TetMesh> via_api = core::MeshPlc(plc, params);
     verified = via_api.ok() && SameMesh(*via_api, m) ? "same" : "DIFFERENT";
   }
+  // Link changes by the insertion that made them (RefineStats::
+  // link_changes_by_kind): lk_KIND and in_KIND.
+  std::string kinds;
+  for (int k = 0; k < 7; ++k) {
+    absl::StrAppend(&kinds, " lk_", refine::kLinkChangeKindName[k], "=", s.link_changes_by_kind[k], " in_",
+                    refine::kLinkChangeKindName[k], "=", s.insertions_by_kind[k]);
+  }
   std::printf(
       "RESULT status=OK out_vertices=%zu out_tets=%zu omega_vertices=%llu omega_tets=%zu "
       "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu destroy_index=%llu links_added=%llu "
       "links_removed=%llu warps=%llu yields=%llu max_degree=%u "
       "wall_prepare=%.6f wall_refine=%.6f wall_output=%.6f cpu_prepare=%.6f cpu_refine=%.6f cpu_output=%.6f "
-      "base_kib=%ld peak_kib=%ld heap_peak=%lld max_re=%.6g min_dih=%.6g verify=%s\n",
+      "base_kib=%ld peak_kib=%ld heap_peak=%lld max_re=%.6g min_dih=%.6g verify=%s%s\n",
       m.positions.size(), m.tets.size(), (unsigned long long)s.vertices, refined->tets.size(),
       (unsigned long long)s.segment_vertices, (unsigned long long)s.facet_vertices,
       (unsigned long long)s.insertions, (unsigned long long)s.destroy_cells_visited,
       (unsigned long long)s.destroy_index_visited,
       (unsigned long long)s.links_added, (unsigned long long)s.links_removed, (unsigned long long)s.warps,
       (unsigned long long)s.yields, s.max_degree, w1 - w0, w2 - w1, w3 - w2, c1 - c0, c2 - c1, c3 - c2,
-      base_kib, peak_kib, static_cast<long long>(heap_peak), q.all.radius_edge.max, q.all.dihedral_deg.min, verified.c_str());
+      base_kib, peak_kib, static_cast<long long>(heap_peak), q.all.radius_edge.max, q.all.dihedral_deg.min, verified.c_str(),
+      kinds.c_str());
   return 0;
 }
 
@@ -506,6 +514,23 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
       std::printf(" %.3g→%.3g: %.1f µs, %.0f B;", prev->tets, r.tets, 1e6 * (r.cpu - prev->cpu) / dt, dmem / dt);
     }
     prev = &r;
+  }
+  std::printf("\n");
+  // The location graph's link changes per insertion, by the insertion that
+  // made them (RefineStats::link_changes_by_kind), and each kind's share of
+  // the insertions: a kind whose cost stays flat but whose share moves
+  // moves the cells+links column.
+  std::printf("  - link changes per insertion by kind (share of the insertions into all meshes):");
+  for (int k = 0; k < 7; ++k) {
+    const std::string name = refine::kLinkChangeKindName[k];
+    std::printf("%s %s", k == 0 ? "" : ";", name.c_str());
+    for (const Row& r : rows) {
+      if (r.r.status != "OK") continue;
+      double ins = 0;  // insertions into every mesh
+      for (const char* kn : refine::kLinkChangeKindName) ins += r.r.D(std::string("in_") + kn);
+      const double n = r.r.D("in_" + name);
+      std::printf(" %s (%s%%)", n > 0 ? F(r.r.D("lk_" + name) / n, 1).c_str() : "-", F(100 * n / ins, 1).c_str());
+    }
   }
   std::printf("\n");
 }

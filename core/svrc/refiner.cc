@@ -277,6 +277,22 @@ class Refiner {
 
   // --- ForceInsert (Figure 3.5) + UpdateLocation (3.6) + PropagateLocation (3.9)
   absl::Status ForceInsertOmega(PointId p, TetId hint);
+  // Adds the link changes made while it lives to RefineStats::
+  // link_changes_by_kind[kind] (an M_Ω point of CD 3 that changed none
+  // counts as kOmegaCd3Unlinked).
+  struct LinkChangeCount {
+    Refiner* r;
+    int kind;
+    uint64_t before;
+    LinkChangeCount(Refiner* refiner, int k)
+        : r(refiner), kind(k), before(refiner->blg_.stats().links_added + refiner->blg_.stats().links_removed) {}
+    ~LinkChangeCount() {
+      const uint64_t d = r->blg_.stats().links_added + r->blg_.stats().links_removed - before;
+      const int k = (kind == kOmegaCd3Linked && d == 0) ? kOmegaCd3Unlinked : kind;
+      r->stats_.link_changes_by_kind[k] += d;
+      ++r->stats_.insertions_by_kind[k];
+    }
+  };
   absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd = kCdSegment);
 
   // --- Collars (stage (d): thesis §3.1.2, Figures 3.5, 3.7–3.9) ---------------
@@ -1583,6 +1599,8 @@ absl::Status Refiner::InsertCreaseVertices() {
 }
 
 absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
+  const int cd = points_.CdOf(p).dim;
+  LinkChangeCount count(this, cd < 3 ? cd : kOmegaCd3Linked);
   delaunay::Delaunay3& dt = omega_.dt();
   const Vec3 pos = points_.Xyz(p);
   const auto result = dt.Insert(pos, p.value(), hint);
@@ -1887,6 +1905,7 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
 }
 
 absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd) {
+  LinkChangeCount count(this, kSegmentMesh);
   SegmentMesh& m = segs_[seg];
   const uint32_t w = m.Next(u);
   const FeatureId f = features_.OfSegment(seg);
@@ -1947,6 +1966,7 @@ absl::Status Refiner::ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd 
 }
 
 absl::Status Refiner::ForceInsertFacet(uint32_t f, PointId p, Vec2 uv, TriId2 hint) {
+  LinkChangeCount count(this, kFacetMesh);
   FacetMesh& m = facets_[f];
   const MeshId mesh = FacetMeshId(f);
   const delaunay::Delaunay2::InsertResult r = m.Insert(uv, p, hint);
@@ -3496,6 +3516,8 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.max_bucket_walk = q.max_walk_one_op;
   st.links_added = blg_.stats().links_added;
   st.links_removed = blg_.stats().links_removed;
+  st.link_changes_by_kind = stats_.link_changes_by_kind;
+  st.insertions_by_kind = stats_.insertions_by_kind;
   st.clipped_cells = omega_.stats().clipped_queries;
   st.sizes_shrunk = omega_.stats().shrunk_sizes;
   st.size_queries = omega_.stats().size_queries;
@@ -3664,6 +3686,10 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
   out->Set("svrc.links_added", static_cast<double>(links_added));
   out->Set("svrc.links_removed", static_cast<double>(links_removed));
+  for (int k = 0; k < 7; ++k) {
+    out->Set(absl::StrCat("svrc.link_changes.", kLinkChangeKindName[k]), static_cast<double>(link_changes_by_kind[k]));
+    out->Set(absl::StrCat("svrc.insertions.", kLinkChangeKindName[k]), static_cast<double>(insertions_by_kind[k]));
+  }
   out->Set("svrc.max_degree", max_degree);
   out->Set("svrc.max_aspect", max_aspect);
   out->Set("svrc.predicate_calls", static_cast<double>(predicate_calls));

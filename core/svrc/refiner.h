@@ -262,6 +262,21 @@ struct RefineOptions {
   uint32_t validate_every = 0;
 };
 
+// The insertions RefineStats::link_changes_by_kind tells apart: into M_Ω by
+// the point's containment dimension (an M_Ω point split by whether it
+// changed any link), into a facet mesh, into a segment mesh.
+enum LinkChangeKind : int {
+  kOmegaCd0 = 0,
+  kOmegaCd1 = 1,
+  kOmegaCd2 = 2,
+  kOmegaCd3Linked = 3,
+  kOmegaCd3Unlinked = 4,
+  kFacetMesh = 5,
+  kSegmentMesh = 6,
+};
+inline constexpr const char* kLinkChangeKindName[7] = {"omega_cd0", "omega_cd1", "omega_cd2", "omega_cd3_linked",
+                                                        "omega_cd3_unlinked", "facet", "segment"};
+
 // Run statistics (thesis ch. 5 quantities; guide §7 "measure per run").
 struct RefineStats {
   uint64_t vertices = 0;           // in M_Ω at the end (corners included)
@@ -337,6 +352,13 @@ struct RefineStats {
   uint64_t max_bucket_walk = 0;
   uint64_t links_added = 0;        // LW-events (Lemma 36)
   uint64_t links_removed = 0;
+  // The same link changes (added + removed) split by the insertion that made
+  // them, with the number of such insertions (LinkChangeKind): why the
+  // location graph's work per insertion falls as a mesh grows (each kind's
+  // cost stays flat; the share of insertions next to a feature falls:
+  // bench/RESULTS.md "Session 28").
+  std::array<uint64_t, 7> link_changes_by_kind{};
+  std::array<uint64_t, 7> insertions_by_kind{};
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all

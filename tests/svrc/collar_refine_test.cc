@@ -611,6 +611,41 @@ TEST(CollarRefine, BisectorLinkFilterKeepsLinksConservative) {
   }
 }
 
+// RefineStats::link_changes_by_kind splits the location graph's link
+// changes by the insertion that made them (the output-sensitivity bench
+// prints it): the kinds' insertions are the refiner's insertions, an M_Ω
+// point counted unlinked changed no link, and nearly every change is made
+// by some insertion (the rest by the initial meshes and the labelling).
+TEST(CollarRefine, LinkChangesByKindAddUpToTheLinkCounters) {
+  for (const char* rel : {"a_convex/cube.poly", "b_internal/box_internal_facet.poly"}) {
+    absl::StatusOr<plc::Plc> plc = CaseInput(rel);
+    ASSERT_TRUE(plc.ok()) << plc.status();
+    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+    ASSERT_TRUE(cx.ok()) << cx.status();
+    RefineOptions opt;
+    opt.max_volume = 1e-3;
+    const std::optional<RefinedMesh> r = RefineAndCheck(*plc, *cx, opt, rel);
+    ASSERT_TRUE(r.has_value());
+    const RefineStats& st = r->run.stats;
+    uint64_t omega = 0, changes = 0;
+    for (int k : {kOmegaCd0, kOmegaCd1, kOmegaCd2, kOmegaCd3Linked, kOmegaCd3Unlinked}) omega += st.insertions_by_kind[k];
+    for (uint64_t c : st.link_changes_by_kind) changes += c;
+    EXPECT_EQ(omega, st.insertions) << rel;
+    EXPECT_EQ(st.insertions_by_kind[kSegmentMesh], st.segment_vertices) << rel;
+    EXPECT_GT(st.insertions_by_kind[kFacetMesh], 0u) << rel;
+    EXPECT_GE(st.insertions_by_kind[kFacetMesh], st.facet_vertices) << rel;  // plus segment points entering M_F
+    EXPECT_GT(st.insertions_by_kind[kOmegaCd3Linked], 0u) << rel;
+    EXPECT_GT(st.insertions_by_kind[kOmegaCd3Unlinked], 0u) << rel;
+    EXPECT_EQ(st.link_changes_by_kind[kOmegaCd3Unlinked], 0u) << rel;
+    EXPECT_GE(st.link_changes_by_kind[kOmegaCd3Linked], st.insertions_by_kind[kOmegaCd3Linked]) << rel;
+    const uint64_t all = st.links_added + st.links_removed;
+    EXPECT_LE(changes, all) << rel;
+    EXPECT_GE(changes, all - all / 50) << rel;
+    std::printf("%s: %llu of %llu link changes made by insertions\n", rel, (unsigned long long)changes,
+                (unsigned long long)all);
+  }
+}
+
 // RefineOptions::propagate_size_targets: max_volume targets carried from a
 // size round's labelling to the tets and points of later cavities. Without
 // it the rounds refine in waves, each labelling finding the last round's new
