@@ -359,14 +359,19 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                         refined.status().code() == absl::StatusCode::kFailedPrecondition)) {
       // Below radius_edge 2 the collar path's cell test (aspect τ = 2 ×
       // radius_edge) refines the collars' neighbourhood much further, and
-      // the thesis proves termination only for τ > 2√2 (docs/svrc-collars.md
-      // "Session 14"): say so, a budget overrun alone reads like a bug.
+      // the thesis proves termination only for τ > 2√2 (its collar theorem
+      // assumes τ > 4√2; docs/svrc-collars.md "Session 14", "Session 28"):
+      // say so, a budget overrun or a COLLAR round that does not settle
+      // alone reads like a bug. Measured at 1.5 (session 28): the COLLAR
+      // rounds of crease_pair_30deg, segment_fan.poly and schonhardt.off
+      // diverge (with a 10x lower RepBall floor all three reach the
+      // 1,000,000-vertex budget).
       std::string hint;
-      if (refined.status().code() == absl::StatusCode::kResourceExhausted && params.radius_edge < 2.0) {
+      if (params.radius_edge < 2.0) {
         hint = absl::StrCat("; radius_edge ", params.radius_edge,
-                            " is below 2: with creases below 45 degrees the refinement grows fast as the bound "
-                            "tightens (knife_edge.poly: 5,449 tets at 2, 84,152 at 1.65, the vertex budget at 1.5); "
-                            "try radius_edge 2");
+                            " is below 2: with creases below 45 degrees the refinement near the collars grows fast "
+                            "as the bound tightens and may not settle (two facets at 30 degrees: 33,176 tets at 2, "
+                            "171,695 at 1.65, 387,287 at 1.58, no mesh at 1.5); try a larger radius_edge");
       }
       return mesh::Rewrap(absl::StatusCode::kFailedPrecondition,
                           absl::StrCat(crease_head, "the collar stage did not finish: ", refined.status().message(), hint),
