@@ -244,7 +244,7 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   // Link changes by the insertion that made them (RefineStats::
   // link_changes_by_kind): lk_KIND and in_KIND.
   std::string kinds;
-  for (int k = 0; k < 7; ++k) {
+  for (int k = 0; k < refine::kNumLinkChangeKinds; ++k) {
     absl::StrAppend(&kinds, " lk_", refine::kLinkChangeKindName[k], "=", s.link_changes_by_kind[k], " in_",
                     refine::kLinkChangeKindName[k], "=", s.insertions_by_kind[k]);
   }
@@ -521,7 +521,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
   // the insertions: a kind whose cost stays flat but whose share moves
   // moves the cells+links column.
   std::printf("  - link changes per insertion by kind (share of the insertions into all meshes):");
-  for (int k = 0; k < 7; ++k) {
+  for (int k = 0; k < refine::kNumLinkChangeKinds; ++k) {
     const std::string name = refine::kLinkChangeKindName[k];
     std::printf("%s %s", k == 0 ? "" : ";", name.c_str());
     for (const Row& r : rows) {

@@ -3686,7 +3686,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
   out->Set("svrc.links_added", static_cast<double>(links_added));
   out->Set("svrc.links_removed", static_cast<double>(links_removed));
-  for (int k = 0; k < 7; ++k) {
+  for (int k = 0; k < kNumLinkChangeKinds; ++k) {
     out->Set(absl::StrCat("svrc.link_changes.", kLinkChangeKindName[k]), static_cast<double>(link_changes_by_kind[k]));
     out->Set(absl::StrCat("svrc.insertions.", kLinkChangeKindName[k]), static_cast<double>(insertions_by_kind[k]));
   }

@@ -274,7 +274,8 @@ enum LinkChangeKind : int {
   kFacetMesh = 5,
   kSegmentMesh = 6,
 };
-inline constexpr const char* kLinkChangeKindName[7] = {"omega_cd0", "omega_cd1", "omega_cd2", "omega_cd3_linked",
+inline constexpr int kNumLinkChangeKinds = 7;
+inline constexpr const char* kLinkChangeKindName[kNumLinkChangeKinds] = {"omega_cd0", "omega_cd1", "omega_cd2", "omega_cd3_linked",
                                                         "omega_cd3_unlinked", "facet", "segment"};
 
 // Run statistics (thesis ch. 5 quantities; guide §7 "measure per run").
@@ -357,8 +358,8 @@ struct RefineStats {
   // location graph's work per insertion falls as a mesh grows (each kind's
   // cost stays flat; the share of insertions next to a feature falls:
   // bench/RESULTS.md "Session 28").
-  std::array<uint64_t, 7> link_changes_by_kind{};
-  std::array<uint64_t, 7> insertions_by_kind{};
+  std::array<uint64_t, kNumLinkChangeKinds> link_changes_by_kind{};
+  std::array<uint64_t, kNumLinkChangeKinds> insertions_by_kind{};
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
