@@ -166,6 +166,10 @@ inline int Orient2dUncounted(Vec2 a, Vec2 b, Vec2 c) {
     if (det > eps) return 1;
     if (det < -eps) return -1;
   }
+  // Two equal points: the determinant is exactly 0 (a facet mesh's
+  // triangles tested against the segments whose endpoints they share; every
+  // such call reached the expansion arithmetic).
+  if (c == a || c == b || a == b) return 0;
   return internal::Orient2dExact(a, b, c);
 }
 }  // namespace internal
@@ -193,6 +197,7 @@ inline int Orient3dUncounted(const Vec3& a, const Vec3& b, const Vec3& c, const 
     if (det > eps) return 1;
     if (det < -eps) return -1;
   }
+  if (d == a || d == b || d == c || a == b || a == c || b == c) return 0;  // two equal points: exactly 0
   return internal::Orient3dExact(a, b, c, d);
 }
 }  // namespace internal
