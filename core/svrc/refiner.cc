@@ -1091,7 +1091,7 @@ void Refiner::EnqueueEncroached(BallId b) {
   if (balls_.EncroachQueued(b)) return;
   const int dim = features_.Dim(balls_.Feature(b));
   WorkEvent e{EventType::kEncroached, static_cast<uint8_t>(dim), balls_.Mesh(b), b.value(),
-              balls_.Generation(b), balls_.Radius(b), balls_.Center(b)};
+              balls_.Generation(b), balls_.Radius(b)};
   if (queues_.Enqueue(e).valid()) balls_.SetEncroachQueued(b, true);
 }
 
@@ -1135,9 +1135,9 @@ void Refiner::RefreshEvents(VertexId v, const CellSize* size) {
   EventHandle& u = omega_.UnresolvedEvent(v);
   if (blg_.NumUnresolved(kOmegaMesh, v.value()) > 0) {
     if (queues_.IsQueued(u)) {
-      queues_.Refresh(u, gen, s.corner, s.outradius);
+      queues_.Refresh(u, gen, s.outradius);
     } else {
-      u = queues_.Enqueue({EventType::kUnresolved, 3, kOmegaMesh, v.value(), gen, s.outradius, s.corner});
+      u = queues_.Enqueue({EventType::kUnresolved, 3, kOmegaMesh, v.value(), gen, s.outradius});
     }
   } else if (queues_.IsQueued(u)) {
     queues_.Remove(u);
@@ -1147,9 +1147,9 @@ void Refiner::RefreshEvents(VertexId v, const CellSize* size) {
   EventHandle& k = omega_.SkinnyEvent(v);
   if (IsBad(v, s)) {
     if (queues_.IsQueued(k)) {
-      queues_.Refresh(k, gen, s.kept_corner, s.kept_outradius);
+      queues_.Refresh(k, gen, s.kept_outradius);
     } else {
-      k = queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, v.value(), gen, s.kept_outradius, s.kept_corner});
+      k = queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, v.value(), gen, s.kept_outradius});
     }
   } else if (queues_.IsQueued(k)) {
     queues_.Remove(k);
@@ -1161,12 +1161,10 @@ void Refiner::RefreshSegmentEvents(uint32_t seg, uint32_t v) {
   const SegmentMesh::Size1 s = m.Size(v);
   EventHandle& k = m.SkinnyEvent(v);
   if (IsSkinny(s)) {
-    const uint32_t w = m.Next(s.piece);
-    const Vec3 corner = m.PointAt(0.5 * (m.T(s.piece) + m.T(w)));
     if (queues_.IsQueued(k)) {
-      queues_.Refresh(k, m.CellGeneration(v), corner, s.outradius);
+      queues_.Refresh(k, m.CellGeneration(v), s.outradius);
     } else {
-      k = queues_.Enqueue({EventType::kSkinny, 1, SegMesh(seg), v, m.CellGeneration(v), s.outradius, corner});
+      k = queues_.Enqueue({EventType::kSkinny, 1, SegMesh(seg), v, m.CellGeneration(v), s.outradius});
     }
   } else if (queues_.IsQueued(k)) {
     queues_.Remove(k);
@@ -1178,13 +1176,12 @@ void Refiner::RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size)
   const CellSize2 s = size != nullptr ? *size : m.Size(v);
   const uint32_t gen = m.CellGeneration(v);
   const MeshId mesh = FacetMeshId(f);
-  const Vec3 corner = frames_[f].ToSpace(s.corner);  // informational: rebuilt at pop
   EventHandle& u = m.UnresolvedEvent(v);
   if (blg_.NumUnresolved(mesh, v.value()) > 0) {
     if (queues_.IsQueued(u)) {
-      queues_.Refresh(u, gen, corner, s.outradius);
+      queues_.Refresh(u, gen, s.outradius);
     } else {
-      u = queues_.Enqueue({EventType::kUnresolved, 2, mesh, v.value(), gen, s.outradius, corner});
+      u = queues_.Enqueue({EventType::kUnresolved, 2, mesh, v.value(), gen, s.outradius});
     }
   } else if (queues_.IsQueued(u)) {
     queues_.Remove(u);
@@ -1192,9 +1189,9 @@ void Refiner::RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size)
   EventHandle& k = m.SkinnyEvent(v);
   if (IsSkinny(s)) {
     if (queues_.IsQueued(k)) {
-      queues_.Refresh(k, gen, corner, s.outradius);
+      queues_.Refresh(k, gen, s.outradius);
     } else {
-      k = queues_.Enqueue({EventType::kSkinny, 2, mesh, v.value(), gen, s.outradius, corner});
+      k = queues_.Enqueue({EventType::kSkinny, 2, mesh, v.value(), gen, s.outradius});
     }
   } else if (queues_.IsQueued(k)) {
     queues_.Remove(k);
@@ -1316,8 +1313,14 @@ absl::Status Refiner::Destroy(const WorkEvent& event) {
     return DestroySegmentPiece(seg, segs_[seg].Size(event.object).piece);
   }
   if (event.type == EventType::kSkinny && (event.object & kTetEvent) != 0) {
+    // The tet is the one EnqueueTetIfBad measured (its generation held at
+    // pop), so its circumcentre is the centre computed then, bit for bit.
     const TetId t(event.object & ~kTetEvent);
-    return DestroyOmegaAt(event.center, event.radius, t, omega_.dt().TetVertex(t, 0));
+    Vec3 cc;
+    if (!omega_.PlainCorner(t, &cc)) {
+      return absl::InternalError(absl::StrCat("SVRC: tet ", t.value(), " of a Skinny event has no circumcentre"));
+    }
+    return DestroyOmegaAt(cc, event.radius, t, omega_.dt().TetVertex(t, 0));
   }
   return DestroyOmega(VertexId(event.object), event.type == EventType::kSkinny);
 }
@@ -1852,7 +1855,7 @@ bool Refiner::EnqueueTetIfBad(TetId t) {
   Vec3 cc;
   double r = 0;
   if (!TetBad(t, &cc, &r)) return false;
-  queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, t.value() | kTetEvent, omega_.dt().Generation(t), r, cc});
+  queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, t.value() | kTetEvent, omega_.dt().Generation(t), r});
   return true;
 }
 

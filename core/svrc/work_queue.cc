@@ -65,7 +65,12 @@ EventHandle WorkQueues::Enqueue(const WorkEvent& event) {
     entries_.back().generation = first_generation_;
   }
   Entry& entry = entries_[e];
-  entry.event = event;
+  entry.radius = event.radius;
+  entry.mesh = event.mesh;
+  entry.object = event.object;
+  entry.event_generation = event.generation;
+  entry.type = event.type;
+  entry.dim = event.dim;
   const int q = QueueIndex(event.type, dim);
   Link(e, q, BucketOf(event.radius));
   ++stats_.pushed[static_cast<int>(event.type)];
@@ -151,7 +156,7 @@ std::optional<WorkEvent> WorkQueues::Dequeue() {
   for (int q : PriorityOrder()) {
     if (queue_size_[q] == 0) continue;
     const uint32_t e = PopFrom(q);
-    WorkEvent event = entries_[e].event;
+    WorkEvent event = entries_[e].Event();
     Free(e);
     ++stats_.popped[static_cast<int>(event.type)];
     return event;
@@ -183,18 +188,18 @@ bool WorkQueues::IsQueued(EventHandle handle) const {
   return entry.generation == handle.generation && entry.queue >= 0;
 }
 
-const WorkEvent& WorkQueues::Get(EventHandle handle) const {
+WorkEvent WorkQueues::Get(EventHandle handle) const {
   assert(IsQueued(handle));
-  return entries_[handle.id.value()].event;
+  return entries_[handle.id.value()].Event();
 }
 
 void WorkQueues::DecreaseSize(EventHandle handle, double new_radius) {
   if (!IsQueued(handle)) return;
   const uint32_t e = handle.id.value();
   Entry& entry = entries_[e];
-  if (!(new_radius < entry.event.radius) || !(new_radius >= 0)) return;
+  if (!(new_radius < entry.radius) || !(new_radius >= 0)) return;
   ++stats_.decrease_size;
-  entry.event.radius = new_radius;
+  entry.radius = new_radius;
   const int bucket = BucketOf(new_radius);
   if (bucket == entry.bucket) return;  // same bucket: keep its FIFO position
   const int q = entry.queue;
@@ -205,18 +210,16 @@ void WorkQueues::DecreaseSize(EventHandle handle, double new_radius) {
   Link(e, q, bucket);
 }
 
-void WorkQueues::Refresh(EventHandle handle, uint32_t generation, const geom::Vec3& center,
-                         double radius) {
+void WorkQueues::Refresh(EventHandle handle, uint32_t generation, double radius) {
   if (!IsQueued(handle) || !std::isfinite(radius) || radius < 0) return;
   const uint32_t e = handle.id.value();
-  entries_[e].event.generation = generation;
-  entries_[e].event.center = center;
-  if (radius <= entries_[e].event.radius) {
+  entries_[e].event_generation = generation;
+  if (radius <= entries_[e].radius) {
     DecreaseSize(handle, radius);
     return;
   }
   ++stats_.increase_size;
-  entries_[e].event.radius = radius;
+  entries_[e].radius = radius;
   const int bucket = BucketOf(radius);
   if (bucket != entries_[e].bucket) {
     const int q = entries_[e].queue;
@@ -256,7 +259,7 @@ bool WorkQueues::Validate() const {
       for (uint32_t e = queue.Head(b); e != kNil; e = entries_[e].next) {
         const Entry& entry = entries_[e];
         if (entry.queue != q || entry.bucket != b || entry.prev != prev) return false;
-        if (BucketOf(entry.event.radius) != b) return false;
+        if (BucketOf(entry.radius) != b) return false;
         if (b > queue.cursor) return false;
         prev = e;
         ++count;

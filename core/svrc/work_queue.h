@@ -29,12 +29,16 @@ enum class EventType : uint8_t { kSkinny = 0, kEncroached = 1, kUnresolved = 2, 
 inline constexpr int kNumEventTypes = 4;
 const char* EventTypeName(EventType type);
 
-// One work event: a gap ball ⟨(center, radius), F⟩ to destroy in mesh `mesh`.
+// One work event: a gap ball of radius `radius` to destroy in mesh `mesh`.
 // `dim` selects the queue: the mesh dimension for Skinny, Unresolved and Collar,
 // the dimension of the *ball's* feature (1 or 2) for Encroached (guide §3, 3.11).
-// `object` is the cell's vertex (Skinny/Unresolved: keyed by cell) or the ball id
-// (Encroached/Collar: keyed by ball); `generation` is that object's generation
-// when the event was made, so a popped event is stale iff it moved on.
+// `object` is the cell's vertex (Skinny/Unresolved: keyed by cell), the tet
+// (a Skinny₃ tet event) or the ball id (Encroached/Collar: keyed by ball);
+// `generation` is that object's generation when the event was made, so a
+// popped event is stale iff it moved on. The ball's centre is not stored: the
+// refiner rebuilds it from the live object at pop (a cell's farthest corner,
+// a tet's circumcentre, a ball's centre), which is what the generation
+// test guarantees is unchanged.
 struct WorkEvent {
   EventType type = EventType::kSkinny;
   uint8_t dim = 3;
@@ -42,7 +46,6 @@ struct WorkEvent {
   uint32_t object = 0;
   uint32_t generation = 0;
   double radius = 0;
-  geom::Vec3 center;
 };
 
 // A handle to a queued event: slot + the slot's generation (a popped or removed
@@ -101,18 +104,18 @@ class WorkQueues {
   void DecreaseSize(EventHandle handle, double new_radius);
 
   // ForceInsert's refresh of a cell-keyed event after the cell changed
-  // (Figure 3.5): new generation and centre, and DecreaseSize to the new
-  // radius. Cells only shrink when points are added, so a larger radius is
-  // rounding noise: it is stored in place (same bucket) or re-bucketed and
-  // counted as `increase_size`. No-op on a stale handle.
-  void Refresh(EventHandle handle, uint32_t generation, const geom::Vec3& center, double radius);
+  // (Figure 3.5): new generation, and DecreaseSize to the new radius. Cells
+  // only shrink when points are added, so a larger radius is rounding noise:
+  // it is stored in place (same bucket) or re-bucketed and counted as
+  // `increase_size`. No-op on a stale handle.
+  void Refresh(EventHandle handle, uint32_t generation, double radius);
 
   // Removes a queued event eagerly (lazy deletion is the norm; this is for
   // callers that hold a handle anyway). No-op on a stale handle.
   void Remove(EventHandle handle);
 
   // Frees the storage of the events when none is queued (the slots of a
-  // run's peak stay allocated otherwise: 64 B each, up to 2 M on cube
+  // run's peak stay allocated otherwise: 40 B each, up to 2 M on cube
   // --max-volume 1e-6). Every handle made before stays stale: slots made
   // after start at a generation above any handed out. Returns whether it
   // freed anything.
@@ -120,7 +123,7 @@ class WorkQueues {
   size_t SlotCapacity() const { return entries_.capacity(); }
 
   bool IsQueued(EventHandle handle) const;
-  const WorkEvent& Get(EventHandle handle) const;  // handle must be queued
+  WorkEvent Get(EventHandle handle) const;  // handle must be queued
 
   size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
@@ -149,14 +152,23 @@ class WorkQueues {
 
  private:
   static constexpr uint32_t kNil = 0xFFFFFFFFu;
+  // A queued event and its list links: 40 bytes (64 while it held the
+  // 24-byte centre, which the refiner rebuilds at pop; the queue's slots
+  // were a quarter of cube --max-volume 1e-5's peak heap).
   struct Entry {
-    WorkEvent event;
+    double radius = 0;
+    MeshId mesh;
+    uint32_t object = 0;
+    uint32_t event_generation = 0;  // WorkEvent::generation
     uint32_t prev = kNil, next = kNil;
-    uint32_t generation = 0;
+    uint32_t generation = 0;  // the slot's: handles to a freed slot go stale
+    EventType type = EventType::kSkinny;
+    uint8_t dim = 3;
     int16_t queue = -1;  // -1: free slot
     int16_t bucket = 0;  // BucketOf's range [-1075, 1023]
+    WorkEvent Event() const { return {type, dim, mesh, object, event_generation, radius}; }
   };
-  static_assert(sizeof(Entry) == 64);  // one cache line per queued event
+  static_assert(sizeof(Entry) == 40);
   // A queue's buckets come in chunks of 64, allocated when an event first
   // lands in one (a run touches a few dozen of the 2099 buckets; allocating
   // them all for twelve queues was 200 KB per job).
