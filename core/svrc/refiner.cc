@@ -2971,6 +2971,10 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // The labelling's arrays are the run's peak (massif, cube 1e-5): the event
   // slots of the Run() before it, all free now, go first (§8 item 52).
   if (queues_.ReleaseIfEmpty()) ++stats_.queue_releases;
+  // So do M_Ω's circumcentre cache and size memos when they are large (64 MiB
+  // and 59 MB on cube 1e-6): they refill after the labelling's arrays are
+  // freed (below). RefineOptions::release_label_caches.
+  const bool released = options_.release_label_caches && omega_.ReleaseCaches(options_.release_cache_min_bytes);
   const delaunay::Delaunay3& dt = omega_.dt();
   const uint32_t nv = dt.NumVertices();
   std::vector<Vec3> positions(nv);
@@ -3142,6 +3146,18 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       const TetId t(i);
       if (i >= dt.TetCapacity() || !dt.IsAlive(t) || dt.IsGhost(t)) tet_labels_[i] = TetLabel{};
     }
+  }
+  if (released) {
+    // The labelling's arrays go before the tests below refill M_Ω's caches
+    // (with the caches kept, freeing them early cost 1.2 MB of peak RSS on
+    // cube 1e-5: the same glibc threshold).
+    lab = absl::StatusOr<Labelling>();
+    std::vector<double>().swap(tet_volume);
+    std::vector<uint32_t>().swap(compact);
+    std::vector<uint32_t>().swap(neighbor_slots);
+    std::vector<ConstrainedFace>().swap(faces);
+    std::vector<std::array<uint32_t, 4>>().swap(tets);
+    std::vector<Vec3>().swap(positions);
   }
   bool any = false;
   if (tet_mode_) {

@@ -233,6 +233,14 @@ struct RefineOptions {
   // svrc-collars.md "Session 6"), it cuts hinge.stl's in-collar feature-mesh
   // points 6.5× but not its size, and knife_edge grows 5,268 → 7,304 tets.
   bool early_crease_vertices = false;
+  // A size labelling frees M_Ω's circumcentre cache and size memos before it
+  // builds its arrays, and its arrays before the tests that refill them: the
+  // two no longer add up at the run's heap peak (session 28; the same
+  // refinement: the caches do not change answers).
+  bool release_label_caches = true;
+  // ... only the tables of at least this many bytes (OmegaMesh::
+  // ReleaseCaches: glibc's mmap threshold; 0 releases every table).
+  size_t release_cache_min_bytes = size_t{32} << 20;
   // Snap band of facet arcs, relative to the circle radius (thesis δ, §3.1.2).
   double arc_snap = 0.02;
   // σ: the largest representation angle of the collar surface (radians;
