@@ -237,6 +237,11 @@ struct RefineOptions {
   // builds its arrays, and its arrays before the tests that refill them: the
   // two no longer add up at the run's heap peak (session 28; the same
   // refinement: the caches do not change answers).
+  // Without collars, the cells a ball meets (a new ball's links, Destroy's
+  // cells, the invariant check) are tested against every Delaunay
+  // neighbour's bisector, not only the nearest vertex's (session 28; a
+  // conservative superset either way; docs/svrc-design.md §8 item 57).
+  bool tight_ball_cells = true;
   bool release_label_caches = true;
   // ... only the tables of at least this many bytes (OmegaMesh::
   // ReleaseCaches: glibc's mmap threshold; 0 releases every table).

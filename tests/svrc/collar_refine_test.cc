@@ -541,6 +541,26 @@ TEST(CollarRefine, ReleasedLabelCachesGiveTheSameRefinement) {
   }
 }
 
+// RefineOptions::tight_ball_cells: without collars, the cells a new ball is
+// linked to (and Destroy's cells) pass every Delaunay neighbour's bisector
+// test, not only the nearest vertex's. Still a superset of the cells the ball
+// meets, and the no-collar path's links are order-neutral (§8 item 37), so
+// the refinement is the same bit for bit, with fewer links.
+TEST(CollarRefine, TightBallCellsGiveTheSameRefinementWithFewerLinks) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
+        SameRefinementCase{"b_internal/box_in_box.poly", false, 0}, SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 1e-3},
+        SameRefinementCase{"e_spread/far_offset_close_points.poly", false, 0}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) {
+      o->tight_ball_cells = on;
+      o->validate_every = kSanitized ? 0 : 211;  // every ball linked to each cell it meets
+    });
+    EXPECT_LT(runs[1].stats.links_added, runs[0].stats.links_added) << c.rel;
+    std::printf("%s: %llu links added, %llu with the nearest vertex's bisector only\n", c.rel,
+                (unsigned long long)runs[1].stats.links_added, (unsigned long long)runs[0].stats.links_added);
+  }
+}
+
 // The corpus file `file`, or families::NestedBoxes(3, 1e-2, 1/8) (three
 // regions with max volumes 1e-2, 1.25e-3, 1.5625e-4) for "nested".
 absl::StatusOr<plc::Plc> CaseInput(const std::string& file) {
