@@ -1834,8 +1834,22 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // held each ball. Of the orders measured, newest first gave the fewest
   // tets (§8 item 37).
   if (bisector_filter) std::sort(moved_pieces.begin(), moved_pieces.end(), [](BallId a, BallId b) { return b < a; });
+  // V(p) is the intersection of the half-spaces nearer to p than to each
+  // cavity vertex (its Delaunay neighbours): a ball beyond one of those
+  // bisectors misses it (§8 item 57; without collars, as CellsMeetingBall).
+  const bool tight = options_.tight_ball_cells && !options_.collars;
+  auto misses_new_cell = [&](BallId b) {
+    const Vec3& c = balls_.Center(b);
+    const double pc2 = geom::Dist2(pos, c), r2 = 2.0 * balls_.Radius(b);
+    for (size_t i = 0; i < inew; ++i) {
+      const Vec3& pu = dt.Point(changed[i]);
+      if (pc2 - geom::Dist2(pu, c) > r2 * geom::Dist(pos, pu) * (1 + 1e-9) + 1e-12 * pc2) return true;
+    }
+    return false;
+  };
   for (BallId b : moved_pieces) {
-    if (geom::Dist(pos, balls_.Center(b)) <= (balls_.Radius(b) + sizes[inew].outradius) * (1 + 1e-9)) {
+    if (geom::Dist(pos, balls_.Center(b)) <= (balls_.Radius(b) + sizes[inew].outradius) * (1 + 1e-9) &&
+        !(tight && misses_new_cell(b))) {
       AddBallLink(nv, b);
     }
   }
