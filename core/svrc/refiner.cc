@@ -3058,6 +3058,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     }
   } else {
     tet_ids = dt.FiniteTets();
+    tets.reserve(tet_ids.size());  // exact: doubling left up to 2x (the heap's peak is here)
     for (TetId t : tet_ids) {
       tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
                       dt.TetVertex(t, 3).value()});
