@@ -66,6 +66,14 @@ bool DeepInside2(Vec2 c, double r, Vec2 x) {
   const double dx = x.x - c.x, dy = x.y - c.y;
   return dx * dx + dy * dy < r * r * (1 - 1e-9) - 1e-13 * r;
 }
+// Whether B(c, r) lies wholly beyond the bisector of x and y, on y's side:
+// the signed distance from c to it, (|xc|² − |yc|²) / (2|xy|), exceeds r,
+// so the ball misses V(x) (which lies on x's side). xc2 = |xc|², yc2 =
+// |yc|², xy = |xy|. Conservative: the relative slack and 10^−12·scale2 keep
+// rounding on the side of "may meet" (guide §3 allows inflated location).
+bool BallBeyondBisector(double xc2, double yc2, double xy, double r, double scale2) {
+  return xc2 - yc2 > 2.0 * r * xy * (1 + 1e-9) + 1e-12 * scale2;
+}
 // A deterministic offset in [−1, 1) from a point id (splitmix64): the
 // Steiner points of facet and segment meshes are moved off the exact
 // circumcentre/midpoint by 10^−6 of the gap radius (docs/svrc-design.md §8
@@ -945,43 +953,22 @@ void Refiner::CellsMeetingBall(const Vec3& c, double r, VertexId w, std::vector<
   const delaunay::Delaunay3& dt = omega_.dt();
   const Vec3& pw = dt.Point(w);
   const double wc2 = geom::Dist2(pw, c);
-  // V(x) lies in the half-space of points nearer to x than to y, for every
-  // y; that half-space meets B(c, r) only if the signed distance from c to
-  // the bisector of xy, (|xc|² − |yc|²) / (2|xy|), is at most r. Conservative
-  // (guide §3 allows inflation for location); the relative slack keeps
-  // rounding on that side.
-  auto may_meet = [&](const Vec3& px, const Vec3& py, double yc2) {
-    return geom::Dist2(px, c) - yc2 <= 2.0 * r * geom::Dist(px, py) * (1 + 1e-9) + 1e-12 * wc2;
-  };
-  ++stamp_;
-  if (mark_.size() < dt.NumVertices()) mark_.resize(dt.NumVertices() + 64, 0);
-  out->clear();
-  if (loose || !options_.tight_ball_cells || options_.collars) {
-    // Against w's bisector only (w: the vertex nearest c, or the cell
-    // holding c): every cell admitted is output and expanded.
-    out->push_back(w);
-    mark_[w.value()] = stamp_;
-    for (size_t i = 0; i < out->size(); ++i) {
-      // A view into M_Ω's neighbour cache (no copy); valid until the next
-      // vertex query of dt, and the loop body makes none.
-      for (VertexId x : dt.NeighborsView((*out)[i])) {
-        if (mark_[x.value()] == stamp_) continue;
-        mark_[x.value()] = stamp_;
-        if (may_meet(dt.Point(x), pw, wc2)) out->push_back(x);
-      }
-    }
-    return;
-  }
-  // Admitted by w's bisector as above, then kept (output, and expanded) only
-  // if every Delaunay neighbour's bisector passes too: V(x) is the
-  // intersection of those half-spaces. The cells B truly meets are
-  // connected (B is, and they cover it) and all pass, so the search still
-  // reaches each of them; measured, 41% of the cells w's test admits fail
-  // (cube --max-volume 1e-5, example.poly). Without collars only: the
+  // V(x) lies in the half-space of points nearer to x than to any y: a cell
+  // is admitted when w's bisector allows it (w: the vertex nearest c, or the
+  // cell holding c), and kept (output, and searched from) when every
+  // Delaunay neighbour's bisector allows it too, V(x) being the intersection
+  // of those half-spaces. The cells B truly meets are connected (B is, and
+  // they cover it) and all pass, so the search still reaches each of them;
+  // measured, 41% of the cells w's test admits fail (cube --max-volume 1e-5,
+  // example.poly). The neighbours' test only without collars: the
   // refinement is then the same bit for bit (the no-collar path's links are
   // order-neutral, §8 item 37); with collars FastCollarSize and the event
   // order read the links, and the outputs moved (schonhardt.off 47,338 →
-  // 55,851 tets).
+  // 55,851 tets). `loose` (the invariant check) keeps w's test alone.
+  const bool tight = !loose && options_.tight_ball_cells && !options_.collars;
+  ++stamp_;
+  if (mark_.size() < dt.NumVertices()) mark_.resize(dt.NumVertices() + 64, 0);
+  out->clear();
   std::vector<VertexId>& cand = cmb_candidates_;
   cand.clear();
   cand.push_back(w);
@@ -989,21 +976,27 @@ void Refiner::CellsMeetingBall(const Vec3& c, double r, VertexId w, std::vector<
   for (size_t i = 0; i < cand.size(); ++i) {
     const VertexId xi = cand[i];
     const Vec3& px = dt.Point(xi);
+    // A view into M_Ω's neighbour cache (no copy); valid until the next
+    // vertex query of dt, and the loop body makes none.
     const std::span<const VertexId> nbrs = dt.NeighborsView(xi);
-    bool meets = true;
-    for (VertexId y : nbrs) {
-      const Vec3& py = dt.Point(y);
-      if (!may_meet(px, py, geom::Dist2(py, c))) {
-        meets = false;
-        break;
+    if (tight && xi != w) {
+      const double xc2 = geom::Dist2(px, c);
+      bool meets = true;
+      for (VertexId y : nbrs) {
+        const Vec3& py = dt.Point(y);
+        if (BallBeyondBisector(xc2, geom::Dist2(py, c), geom::Dist(px, py), r, wc2)) {
+          meets = false;
+          break;
+        }
       }
+      if (!meets) continue;
     }
-    if (!meets && xi != w) continue;
     out->push_back(xi);
     for (VertexId x : nbrs) {
       if (mark_[x.value()] == stamp_) continue;
       mark_[x.value()] = stamp_;
-      if (may_meet(dt.Point(x), pw, wc2)) cand.push_back(x);
+      const Vec3& px2 = dt.Point(x);
+      if (!BallBeyondBisector(geom::Dist2(px2, c), wc2, geom::Dist(px2, pw), r, wc2)) cand.push_back(x);
     }
   }
 }
@@ -1804,7 +1797,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     auto beyond_bisector = [&](BallId b) {
       const Vec3& c = balls_.Center(b);
       const double uc2 = geom::Dist2(pu, c);
-      return uc2 - geom::Dist2(pos, c) > 2.0 * balls_.Radius(b) * up * (1 + 1e-9) + 1e-12 * uc2;
+      return BallBeyondBisector(uc2, geom::Dist2(pos, c), up, balls_.Radius(b), uc2);
     };
     auto piece_meets = [&](BallId b) {
       if (bisector_filter && beyond_bisector(b)) return false;
@@ -1840,10 +1833,10 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   const bool tight = options_.tight_ball_cells && !options_.collars;
   auto misses_new_cell = [&](BallId b) {
     const Vec3& c = balls_.Center(b);
-    const double pc2 = geom::Dist2(pos, c), r2 = 2.0 * balls_.Radius(b);
+    const double pc2 = geom::Dist2(pos, c);
     for (size_t i = 0; i < inew; ++i) {
       const Vec3& pu = dt.Point(changed[i]);
-      if (pc2 - geom::Dist2(pu, c) > r2 * geom::Dist(pos, pu) * (1 + 1e-9) + 1e-12 * pc2) return true;
+      if (BallBeyondBisector(pc2, geom::Dist2(pu, c), geom::Dist(pos, pu), balls_.Radius(b), pc2)) return true;
     }
     return false;
   };

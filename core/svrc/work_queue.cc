@@ -65,12 +65,7 @@ EventHandle WorkQueues::Enqueue(const WorkEvent& event) {
     entries_.back().generation = first_generation_;
   }
   Entry& entry = entries_[e];
-  entry.radius = event.radius;
-  entry.mesh = event.mesh;
-  entry.object = event.object;
-  entry.event_generation = event.generation;
-  entry.type = event.type;
-  entry.dim = event.dim;
+  entry.Store(event);
   const int q = QueueIndex(event.type, dim);
   Link(e, q, BucketOf(event.radius));
   ++stats_.pushed[static_cast<int>(event.type)];

@@ -167,6 +167,14 @@ class WorkQueues {
     int16_t queue = -1;  // -1: free slot
     int16_t bucket = 0;  // BucketOf's range [-1075, 1023]
     WorkEvent Event() const { return {type, dim, mesh, object, event_generation, radius}; }
+    void Store(const WorkEvent& e) {
+      type = e.type;
+      dim = e.dim;
+      mesh = e.mesh;
+      object = e.object;
+      event_generation = e.generation;
+      radius = e.radius;
+    }
   };
   static_assert(sizeof(Entry) == 40);
   // A queue's buckets come in chunks of 64, allocated when an event first
