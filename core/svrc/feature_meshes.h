@@ -43,24 +43,34 @@ struct CellSize {
   bool outside_tets = false;  // a star tet is known to lie outside the output
 };
 
-// Per M_Ω tet slot: its region's size target (+inf: none), volume bound and whether the
-// output keeps it, from the refiner's last labelling and carried to new tets
-// (refiner.cc PropagateSizeTargets). Valid while gen == Generation + 1 (a
-// live tet) or gen == Generation (a tet just freed by an insertion).
+// Per M_Ω tet slot: its label class (the region's size target and volume
+// bound, in the refiner's table of classes: one per distinct pair, so a run
+// has one per region volume) and whether the output keeps it, from the
+// refiner's last labelling and carried to new tets (refiner.cc
+// PropagateSizeTargets). Valid while gen == Generation + 1 (a live tet) or
+// gen == Generation (a tet just freed by an insertion). 8 bytes: it held the
+// two doubles itself until session 29 (24 bytes, 69 MB of cube
+// --max-volume 1e-6's 419 MB heap during its refinement).
 struct TetLabel {
-  uint32_t gen = 0;
-  bool kept = false;  // next to gen: 24 bytes, not 32 (one per tet slot)
+  static constexpr uint32_t kClassMask = (uint32_t{1} << 30) - 1;
+  static constexpr uint32_t kKept = uint32_t{1} << 30;
   // Refiner::BreakSlivers: a round found this tet clear for good (not kept,
   // no angle below the bound, no plain circumcentre: what the tet alone
-  // decides), so the next round of the series skips it. False in every label
+  // decides), so the next round of the series skips it. Clear in every label
   // written for a new tet.
-  bool sliver_clear = false;
-  double target = HUGE_VAL;
-  // Its region's max_volume in normalised coordinates (+inf: none); read by
-  // the per-tet volume test (RefineOptions::tet_volumes).
-  double volume = HUGE_VAL;
+  static constexpr uint32_t kSliverClear = uint32_t{1} << 31;
+  uint32_t gen = 0;
+  uint32_t bits = 0;  // class (bits 0–29) | kKept | kSliverClear; class 0: no target, no bound
+
+  static TetLabel Make(uint32_t gen, bool kept, uint32_t label_class) {
+    return {gen, label_class | (kept ? kKept : 0)};
+  }
+  bool kept() const { return (bits & kKept) != 0; }
+  uint32_t label_class() const { return bits & kClassMask; }
+  bool sliver_clear() const { return (bits & kSliverClear) != 0; }
+  void set_sliver_clear(bool clear) { bits = clear ? bits | kSliverClear : bits & ~kSliverClear; }
 };
-static_assert(sizeof(TetLabel) == 24);  // one per M_Ω tet slot
+static_assert(sizeof(TetLabel) == 8);  // one per M_Ω tet slot
 
 // Clips the convex polygon `poly` (its vertices in order) to the box in
 // place, Sutherland–Hodgman against lo_k <= x_k and x_k <= hi_k in the order
@@ -144,7 +154,7 @@ class OmegaMesh {
     if (labels_ == nullptr) return false;
     if (dt_.IsGhost(t)) return true;
     return t.value() < labels_->size() && (*labels_)[t.value()].gen == dt_.Generation(t) + 1 &&
-           !(*labels_)[t.value()].kept;
+           !(*labels_)[t.value()].kept();
   }
   // What an insertion added to one vertex's star: its new tets, the largest
   // |cc − v| over them (+inf if one is a ghost, flat, or has its

@@ -195,14 +195,14 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // of the labelling). Two records: the tets are neighbours; more: not a
   // tetrahedralization (reported for the smallest (a, b, c), with its three
   // smallest slots).
-  const bool given = in.neighbor_slots.size() == 4 * nt && in.find_face != nullptr;
+  const bool given = in.neighbor_slot != nullptr && in.find_face != nullptr;
   std::optional<TetFaces> tet_faces;
   std::vector<uint32_t> own_nbr;
   if (!given) {
     tet_faces.emplace(in.tets, nv);
     own_nbr.assign(4 * nt, kNoTet);
   }
-  const std::span<const uint32_t> nbr = given ? in.neighbor_slots : std::span<const uint32_t>(own_nbr);
+  auto nbr = [&](uint32_t s) { return given ? in.neighbor_slot(s) : own_nbr[s]; };
   if (!given) {
     TetFaces::Overused bad;
     if (!tet_faces->Match(
@@ -220,8 +220,11 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   Labelling out;
 
   // --- Constrained faces: find their slots; duplicates: first wins. --------
-  constexpr uint32_t kNoFace = 0xFFFFFFFFu;
-  std::vector<uint32_t> slot_cface(4 * nt, kNoFace);
+  // One bit per tet face slot: the face is constrained (the flood stops
+  // there). A bit, not the face's index: 16 bytes per tet were a fifth of
+  // the labelling's arrays at cube --max-volume 1e-6's heap peak.
+  std::vector<uint64_t> constrained_slot((4 * nt + 63) / 64, 0);
+  auto mark_constrained = [&](uint32_t s) { constrained_slot[s >> 6] |= uint64_t{1} << (s & 63); };
   std::vector<std::array<uint32_t, 2>> cface_slots(ncf, {kNoTet, kNoTet});
   {
     std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> keys(ncf);
@@ -255,7 +258,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       uint32_t first_slot = kNoTet;
       if (given) {
         const uint32_t s = in.find_face(k[0], k[1], k[2]);
-        if (s != kNoTet) first_slot = nbr[s] != kNoTet ? std::min(s, nbr[s]) : s;
+        if (s != kNoTet) first_slot = nbr(s) != kNoTet ? std::min(s, nbr(s)) : s;
       } else {
         for (const TetFace& f : tet_faces->Bucket(k[0])) {
           if (f.b == k[1] && f.c == k[2]) {
@@ -270,10 +273,10 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
             in.constrained_faces[idx].facet, " is not a face of the tetrahedralization"));
       }
       cface_slots[idx][0] = first_slot;
-      slot_cface[first_slot] = idx;
-      if (nbr[first_slot] != kNoTet) {
-        cface_slots[idx][1] = nbr[first_slot];
-        slot_cface[nbr[first_slot]] = idx;
+      mark_constrained(first_slot);
+      if (const uint32_t other = nbr(first_slot); other != kNoTet) {
+        cface_slots[idx][1] = other;
+        mark_constrained(other);
       }
     }
   }
@@ -296,12 +299,13 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       ++comp.num_tets;
       for (int f = 0; f < 4; ++f) {
         const uint32_t s = 4 * t + f;
-        if (slot_cface[s] != kNoFace) continue;
-        if (nbr[s] == kNoTet) {
+        if ((constrained_slot[s >> 6] >> (s & 63) & 1) != 0) continue;
+        const uint32_t other = nbr(s);
+        if (other == kNoTet) {
           comp.touches_box = true;
           continue;
         }
-        const uint32_t u = nbr[s] / 4;
+        const uint32_t u = other / 4;
         if (out.tet_component[u] == kNoTet) {
           out.tet_component[u] = cid;
           stack.push_back(u);

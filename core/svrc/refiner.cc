@@ -630,8 +630,30 @@ class Refiner {
   // Per M_Ω tet slot (TetLabel): set by SetSizeTargets' labelling, carried
   // to new tets by PropagateSizeTargets; empty while M_Ω is not labelled.
   util::PodVector<TetLabel> tet_labels_;
+  // The labels' classes: a region's size target (circumradius) and volume
+  // bound, normalised (+inf: none). Class 0 is (+inf, +inf). Append-only,
+  // so a pair keeps its class across labellings (SetSizeTargets compares
+  // classes to find unchanged labels).
+  struct LabelClass {
+    double target = HUGE_VAL;
+    double volume = HUGE_VAL;
+  };
+  std::vector<LabelClass> label_classes_{LabelClass{}};
+  std::map<std::pair<double, double>, uint32_t> label_class_index_{{{HUGE_VAL, HUGE_VAL}, 0}};
+  // The class of the pair, added if new; nullopt past 2^30 classes.
+  std::optional<uint32_t> LabelClassOf(double target, double volume);
+  const LabelClass& ClassOf(const TetLabel& lab) const { return label_classes_[lab.label_class()]; }
   void PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inserted);
   std::vector<TetLabel> created_labels_;  // scratch
+  // Per M_Ω tet slot: the queue slot of its latest Skinny tet event, or
+  // kNoTetEvent. A tet's events die with it (EventLive: the generation moves
+  // on), so ForceInsertOmega removes them from the queue when the tet is
+  // destroyed instead of leaving them until popped. Cube --max-volume 1e-6
+  // pushes 3.0 M tet events and 90% of them were popped stale; waiting in the
+  // queue, they were its peak of 2.3 M slots (91 MB of a 419 MB heap).
+  static constexpr uint32_t kNoTetEvent = 0xFFFFFFFFu;
+  util::PodVector<uint32_t> tet_event_;
+  void DropDeadTetEvents(std::span<const TetId> destroyed);
   // Collars (stage (d)).
   const plc::FeatureComplex* complex_ = nullptr;
   CollarIndex collars_;
@@ -1654,6 +1676,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
                                             ") of M_Ω at (", pos.x, ", ", pos.y, ", ", pos.z, ")"));
   }
   ++stats_.insertions;
+  // Before any new tet (some in these slots) is tested and enqueued.
+  if (!tet_event_.empty()) DropDeadTetEvents(result.destroyed);
   const VertexId nv = result.vertex;
   omega_.AddVertex(nv, p);
   points_.SetVertex(p, kOmegaMesh, nv.value());
@@ -1879,7 +1903,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
 bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   const delaunay::Delaunay3& dt = omega_.dt();
   const TetLabel* lab = dt.IsGhost(t) ? nullptr : LiveLabel(t);
-  if (lab == nullptr || !lab->kept) return false;
+  if (lab == nullptr || !lab->kept()) return false;
   if (!omega_.PlainCorner(t, cc)) return false;
   std::array<Vec3, 4> q;
   for (int k = 0; k < 4; ++k) q[k] = dt.Point(dt.TetVertex(t, k));
@@ -1896,18 +1920,45 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
     // The bound itself, with a relative margin of 1e-9 for the rounding of
     // this determinant and of the back map to input coordinates (the
     // output's volumes are computed there).
-    if (lab->volume == HUGE_VAL) return false;
-    return Volume6(q) > 6.0 * lab->volume * (1 - 1e-9);
+    const double volume = ClassOf(*lab).volume;
+    if (volume == HUGE_VAL) return false;
+    return Volume6(q) > 6.0 * volume * (1 - 1e-9);
   }
-  return r > lab->target;
+  return r > ClassOf(*lab).target;
+}
+
+std::optional<uint32_t> Refiner::LabelClassOf(double target, double volume) {
+  const auto it = label_class_index_.find({target, volume});
+  if (it != label_class_index_.end()) return it->second;
+  if (label_classes_.size() > TetLabel::kClassMask) return std::nullopt;
+  const uint32_t c = static_cast<uint32_t>(label_classes_.size());
+  label_classes_.push_back({target, volume});
+  label_class_index_.emplace(std::make_pair(target, volume), c);
+  return c;
 }
 
 bool Refiner::EnqueueTetIfBad(TetId t) {
   Vec3 cc;
   double r = 0;
   if (!TetBad(t, &cc, &r)) return false;
-  queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, t.value() | kTetEvent, omega_.dt().Generation(t), r});
+  const EventHandle h =
+      queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, t.value() | kTetEvent, omega_.dt().Generation(t), r});
+  if (h.valid() && options_.drop_dead_tet_events) {
+    if (tet_event_.size() <= t.value()) {
+      const uint32_t cap = omega_.dt().TetCapacity();
+      util::GrowExactly(tet_event_, cap + cap / 2, kNoTetEvent);
+    }
+    tet_event_[t.value()] = h.id.value();
+  }
   return true;
+}
+
+void Refiner::DropDeadTetEvents(std::span<const TetId> destroyed) {
+  for (TetId d : destroyed) {
+    if (d.value() >= tet_event_.size() || tet_event_[d.value()] == kNoTetEvent) continue;
+    queues_.RemoveObjectEvent(EventId(tet_event_[d.value()]), kOmegaMesh, d.value() | kTetEvent);
+    tet_event_[d.value()] = kNoTetEvent;
+  }
 }
 
 // max_volume between size rounds: without it a vertex inserted after a
@@ -1942,9 +1993,9 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
   for (size_t k = 0; k < n; ++k) {
     const TetId c = inserted.created[k];
     const bool known = created_labels_[k].gen != 0;
-    const double target = created_labels_[k].target;
-    tet_labels_[c.value()] = {known ? dt.Generation(c) + 1 : 0, created_labels_[k].kept,
-                              /*sliver_clear=*/false, target, created_labels_[k].volume};
+    const double target = ClassOf(created_labels_[k]).target;
+    tet_labels_[c.value()] = TetLabel::Make(known ? dt.Generation(c) + 1 : 0, created_labels_[k].kept(),
+                                            created_labels_[k].label_class());
     if (!known || target == HUGE_VAL || dt.IsGhost(c) || tet_sizes_) continue;
     for (int i = 0; i < 4; ++i) {
       const uint32_t v = dt.TetVertex(c, i).value();
@@ -3021,7 +3072,10 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const AddSeconds timer(&stats_.seconds_labelling);
   // The labelling's arrays are the run's peak (massif, cube 1e-5): the event
   // slots of the Run() before it, all free now, go first (§8 item 52).
-  if (queues_.ReleaseIfEmpty()) ++stats_.queue_releases;
+  if (queues_.ReleaseIfEmpty()) {
+    ++stats_.queue_releases;
+    util::PodVector<uint32_t>().swap(tet_event_);  // every slot it names is gone
+  }
   // So do M_Ω's circumcentre cache and size memos when they are large (64 MiB
   // and 59 MB on cube 1e-6): they refill after the labelling's arrays are
   // freed (below). RefineOptions::release_label_caches.
@@ -3084,19 +3138,17 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   in.keep_bounding_box = options_.keep_bounding_box || facets_.empty();
   // M_Ω's own tets: the adjacency comes from Delaunay3 instead of the
   // labelling's face table (§8 item 43; the same labelling).
-  std::vector<uint32_t> compact, neighbor_slots;
+  std::vector<uint32_t> compact;
   std::vector<TetId> star;
   if (!tet_ids.empty() && options_.label_with_adjacency) {
     compact.assign(dt.TetCapacity(), kNoTet);
     for (uint32_t i = 0; i < tet_ids.size(); ++i) compact[tet_ids[i].value()] = i;
-    neighbor_slots.assign(4 * tet_ids.size(), kNoTet);
-    for (uint32_t i = 0; i < tet_ids.size(); ++i) {
-      for (int f = 0; f < 4; ++f) {
-        const TetId n = dt.Neighbor(tet_ids[i], f);
-        if (!dt.IsGhost(n)) neighbor_slots[4 * i + f] = 4 * compact[n.value()] + dt.NeighborFace(tet_ids[i], f);
-      }
-    }
-    in.neighbor_slots = neighbor_slots;
+    in.neighbor_slot = [&](uint32_t s) -> uint32_t {
+      const TetId t = tet_ids[s >> 2];
+      const int f = static_cast<int>(s & 3);
+      const TetId n = dt.Neighbor(t, f);
+      return dt.IsGhost(n) ? kNoTet : 4 * compact[n.value()] + dt.NeighborFace(t, f);
+    };
     in.find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
       dt.Star(VertexId(a), &star);
       for (TetId t : star) {
@@ -3140,21 +3192,30 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // Cells are sized on the output's tets from now on (item 33); the memos
   // of Size() drop.
   omega_.SetLabels(!tet_labels_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_labels_ : nullptr);
-  // The volume bound of each kept tet's region, normalised; its size target
-  // (below) is the circumradius of a regular tet of that volume (edge a =
-  // (6√2·V)^(1/3), circumradius a·√6/4).
-  std::vector<double> tet_volume(tets.size(), HUGE_VAL);
+  // The volume bound of each kept component (region), normalised; its size
+  // target is the circumradius of a regular tet of that volume (edge a =
+  // (6√2·V)^(1/3), circumradius a·√6/4); and the label class of the pair.
+  // Components that are not kept have neither (class 0).
+  const size_t ncomp = lab->components.size();
+  std::vector<double> comp_volume(ncomp, HUGE_VAL), comp_target(ncomp, HUGE_VAL);
+  std::vector<uint32_t> comp_class(ncomp, 0);
   bool uniform = true;
   double first_volume = -1;
-  for (size_t t = 0; t < tets.size(); ++t) {
-    if (!lab->Kept(static_cast<uint32_t>(t))) continue;
+  for (size_t c = 0; c < ncomp; ++c) {
+    if (!lab->components[c].kept) continue;
     double vmax = HUGE_VAL;
-    const double region = lab->components[lab->tet_component[t]].max_volume;
+    const double region = lab->components[c].max_volume;
     if (region > 0) vmax = region;
     if (global_max_volume > 0) vmax = std::min(vmax, global_max_volume);
-    if (vmax != HUGE_VAL) tet_volume[t] = vmax * scale3;  // exact: scale3 is a power of two
-    if (first_volume < 0) first_volume = tet_volume[t];
-    uniform = uniform && tet_volume[t] == first_volume;
+    if (vmax != HUGE_VAL) {
+      comp_volume[c] = vmax * scale3;  // exact: scale3 is a power of two
+      comp_target[c] = std::cbrt(6.0 * std::sqrt(2.0) * comp_volume[c]) * std::sqrt(6.0) / 4.0;
+    }
+    const std::optional<uint32_t> cls = LabelClassOf(comp_target[c], comp_volume[c]);
+    if (!cls) return absl::ResourceExhaustedError("more than 2^30 distinct region volume bounds");
+    comp_class[c] = *cls;
+    if (first_volume < 0) first_volume = comp_volume[c];
+    uniform = uniform && comp_volume[c] == first_volume;
   }
   // With one target for every output tet, "some kept tet at v is above it"
   // is "R_v of v's kept tets is above it": the cell test flags the same tets
@@ -3166,23 +3227,22 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const bool bounded = !uniform || (first_volume >= 0 && first_volume != HUGE_VAL);
   if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
-    const bool kept = lab->Kept(static_cast<uint32_t>(t));
-    const double rt = kept && tet_volume[t] != HUGE_VAL
-                          ? std::cbrt(6.0 * std::sqrt(2.0) * tet_volume[t]) * std::sqrt(6.0) / 4.0
-                          : HUGE_VAL;
+    const uint32_t c = lab->tet_component[t];
+    const bool kept = lab->components[c].kept;
+    const double rt = comp_target[c];
     if (!tet_labels_.empty()) {
       const uint32_t slot = tet_ids[t].value();
-      const TetLabel fresh{dt.Generation(tet_ids[t]) + 1, kept, false, rt, kept ? tet_volume[t] : HUGE_VAL};
+      // sliver_clear starts clear, as in every new label.
+      const TetLabel fresh = TetLabel::Make(dt.Generation(tet_ids[t]) + 1, kept, comp_class[c]);
       if (slot < old_labels) {
         const TetLabel& old = tet_labels_[slot];
-        unchanged[t] = old.gen == fresh.gen && old.kept == fresh.kept && old.target == fresh.target &&
-                       old.volume == fresh.volume;
+        unchanged[t] = old.gen == fresh.gen && old.kept() == fresh.kept() && old.label_class() == fresh.label_class();
         stats_.labels_changed += unchanged[t] == 0;
       }
       tet_labels_[slot] = fresh;
     }
     if (!kept) continue;
-    if (tet_volume[t] == HUGE_VAL) continue;
+    if (comp_volume[c] == HUGE_VAL) continue;
     if (tet_sizes_) continue;
     for (uint32_t v : tets[t]) {
       if (rt < size_target_[v]) {
@@ -3204,9 +3264,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     // (with the caches kept, freeing them early cost 1.2 MB of peak RSS on
     // cube 1e-5: the same glibc threshold).
     lab = absl::StatusOr<Labelling>();
-    std::vector<double>().swap(tet_volume);
     std::vector<uint32_t>().swap(compact);
-    std::vector<uint32_t>().swap(neighbor_slots);
     std::vector<ConstrainedFace>().swap(faces);
     std::vector<std::array<uint32_t, 4>>().swap(tets);
     std::vector<Vec3>().swap(positions);
@@ -3264,23 +3322,23 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
     const TetId t(s);
     const TetLabel* lab = LiveLabel(t);
     if (lab == nullptr) continue;  // a free slot, or a tet without a label
-    if (reuse && lab->sliver_clear) {
+    if (reuse && lab->sliver_clear()) {
       ++stats_.sliver_scan_reused;
       continue;
     }
     if (!dt.IsAlive(t) || dt.IsGhost(t)) continue;
     // TetLabel::sliver_clear: set below on every live label a round reads,
     // so the first round leaves none stale; new tets' labels start clear of it.
-    bool& clear = tet_labels_[t.value()].sliver_clear;
-    clear = true;  // until a test below keeps it
-    if (!lab->kept) continue;
+    TetLabel& label = tet_labels_[t.value()];
+    label.set_sliver_clear(true);  // until a test below keeps it
+    if (!lab->kept()) continue;
     std::array<Vec3, 4> x;
     for (int k = 0; k < 4; ++k) x[k] = dt.Point(dt.TetVertex(t, k));
     if (Volume6(x) > LongestEdgeCubed(x) * sin_min) continue;
     if (!(MeasureSliverTet(x[0], x[1], x[2], x[3]).min_dihedral_deg < min_deg)) continue;
     Vec3 cc;
     if (!omega_.PlainCorner(t, &cc)) continue;
-    clear = false;  // the ball test below may change when balls die
+    label.set_sliver_clear(false);  // the ball test below may change when balls die
     // Only slivers whose circumcentre would be inserted as is: one inside a
     // lower ball would split that facet triangle or segment piece instead,
     // and such splits next to the features cascade (measured:
@@ -3582,6 +3640,7 @@ void Refiner::FillCounters(RefineStats* out) const {
     st.events_pushed[i] = q.pushed[i];
     st.events_popped[i] = q.popped[i];
     st.events_stale[i] = q.stale[i];
+    st.events_removed_dead[i] = q.removed_dead[i];
   }
   st.buckets_walked = q.buckets_walked;
   st.max_bucket_walk = q.max_walk_one_op;
@@ -3639,7 +3698,7 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
       out.tets.push_back(tet);
       if (labelled) {
         const TetLabel* lab = LiveLabel(t);
-        out.tet_outside.push_back(lab != nullptr && !lab->kept ? 1 : 0);
+        out.tet_outside.push_back(lab != nullptr && !lab->kept() ? 1 : 0);
       }
     }
   }
@@ -3743,6 +3802,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
     out->Set(absl::StrCat("svrc.events_pushed.", kTypes[i]), static_cast<double>(events_pushed[i]));
     out->Set(absl::StrCat("svrc.events_popped.", kTypes[i]), static_cast<double>(events_popped[i]));
     out->Set(absl::StrCat("svrc.events_stale.", kTypes[i]), static_cast<double>(events_stale[i]));
+    out->Set(absl::StrCat("svrc.events_removed_dead.", kTypes[i]), static_cast<double>(events_removed_dead[i]));
   }
   out->Set("svrc.buckets_walked", static_cast<double>(buckets_walked));
   out->Set("svrc.size_rounds", static_cast<double>(size_rounds));

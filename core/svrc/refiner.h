@@ -243,6 +243,10 @@ struct RefineOptions {
   // conservative superset either way; docs/svrc-design.md §8 item 57).
   bool tight_ball_cells = true;
   bool release_label_caches = true;
+  // A tet's queued Skinny event is removed when the tet is destroyed, not
+  // left in the queue until popped stale (session 29; the same refinement:
+  // the order of the live events is unchanged).
+  bool drop_dead_tet_events = true;
   // ... only the tables of at least this many bytes (OmegaMesh::
   // ReleaseCaches: glibc's mmap threshold; 0 releases every table).
   size_t release_cache_min_bytes = size_t{32} << 20;
@@ -357,6 +361,7 @@ struct RefineStats {
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
   std::array<uint64_t, 4> events_stale{};
+  std::array<uint64_t, 4> events_removed_dead{};  // removed when their tet died (RemoveObjectEvent), never popped
   uint64_t destroy_cells_visited = 0;  // |𝒱| summed over Destroy calls
   uint64_t destroy_index_visited = 0;  // PendingPoints nodes and points read by Destroy (destroy_index)
   uint64_t destroy_balls_read = 0;     // balls Destroy in M_Ω tested for a warp or a yield

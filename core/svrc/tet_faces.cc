@@ -41,10 +41,10 @@ TetFaces::TetFaces(std::span<const std::array<uint32_t, 4>> tets, size_t num_ver
     const uint32_t base = static_cast<uint32_t>(4 * t);
     const uint32_t v0 = static_cast<uint32_t>(s[0] >> 2), v1 = static_cast<uint32_t>(s[1] >> 2),
                    v2 = static_cast<uint32_t>(s[2] >> 2), v3 = static_cast<uint32_t>(s[3] >> 2);
-    faces_[fill[v1]++] = TetFace{v1, v2, v3, base + static_cast<uint32_t>(s[0] & 3)};
-    faces_[fill[v0]++] = TetFace{v0, v2, v3, base + static_cast<uint32_t>(s[1] & 3)};
-    faces_[fill[v0]++] = TetFace{v0, v1, v3, base + static_cast<uint32_t>(s[2] & 3)};
-    faces_[fill[v0]++] = TetFace{v0, v1, v2, base + static_cast<uint32_t>(s[3] & 3)};
+    faces_[fill[v1]++] = TetFace{v2, v3, base + static_cast<uint32_t>(s[0] & 3)};
+    faces_[fill[v0]++] = TetFace{v2, v3, base + static_cast<uint32_t>(s[1] & 3)};
+    faces_[fill[v0]++] = TetFace{v1, v3, base + static_cast<uint32_t>(s[2] & 3)};
+    faces_[fill[v0]++] = TetFace{v1, v2, base + static_cast<uint32_t>(s[3] & 3)};
   }
 }
 
@@ -92,7 +92,7 @@ bool TetFaces::Match(absl::FunctionRef<void(uint32_t, uint32_t)> pair, Overused*
       }
     }
     if (bad != kNil) {
-      bad_face->a = r[bad].a;
+      bad_face->a = static_cast<uint32_t>(a);
       bad_face->b = r[bad].b;
       bad_face->c = r[bad].c;
       bad_face->count = count[bad];

@@ -229,6 +229,16 @@ void WorkQueues::Remove(EventHandle handle) {
   Free(handle.id.value());
 }
 
+bool WorkQueues::RemoveObjectEvent(EventId id, MeshId mesh, uint32_t object) {
+  if (!id.valid() || id.value() >= entries_.size()) return false;
+  const Entry& entry = entries_[id.value()];
+  if (entry.queue < 0 || entry.mesh != mesh || entry.object != object) return false;
+  ++stats_.removed_dead[static_cast<int>(entry.type)];
+  Unlink(id.value());
+  Free(id.value());
+  return true;
+}
+
 double WorkQueues::LargestPendingRadius() const {
   double best = 0;
   for (int q = 0; q < kNumQueues; ++q) {

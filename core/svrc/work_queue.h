@@ -113,6 +113,11 @@ class WorkQueues {
   // Removes a queued event eagerly (lazy deletion is the norm; this is for
   // callers that hold a handle anyway). No-op on a stale handle.
   void Remove(EventHandle handle);
+  // Removes the event queued in slot `id` if it is an event of `object` in
+  // `mesh` (any type), for a caller that kept the slot only (4 bytes, not a
+  // handle's 8) and knows every event of that object to be stale: it then
+  // need not wait in the queue until popped. Returns whether one was removed.
+  bool RemoveObjectEvent(EventId id, MeshId mesh, uint32_t object);
 
   // Frees the storage of the events when none is queued (the slots of a
   // run's peak stay allocated otherwise: 40 B each, up to 2 M on cube
@@ -136,6 +141,9 @@ class WorkQueues {
     std::array<uint64_t, kNumEventTypes> pushed{};
     std::array<uint64_t, kNumEventTypes> popped{};
     std::array<uint64_t, kNumEventTypes> stale{};
+    // By RemoveObjectEvent, per type: events whose object died, removed
+    // before they were popped (they would have been stale).
+    std::array<uint64_t, kNumEventTypes> removed_dead{};
     uint64_t rejected = 0;
     uint64_t decrease_size = 0;
     uint64_t increase_size = 0;

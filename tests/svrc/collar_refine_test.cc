@@ -28,6 +28,7 @@
 #include "core/mesh/quality.h"
 #include "core/svrc/assemble.h"
 #include "core/svrc/sliver.h"
+#include "core/svrc/work_queue.h"
 #include "gtest/gtest.h"
 #include "tests/test_support.h"
 
@@ -558,6 +559,26 @@ TEST(CollarRefine, TightBallCellsGiveTheSameRefinementWithFewerLinks) {
     EXPECT_LT(runs[1].stats.links_added, runs[0].stats.links_added) << c.rel;
     std::printf("%s: %llu links added, %llu with the nearest vertex's bisector only\n", c.rel,
                 (unsigned long long)runs[1].stats.links_added, (unsigned long long)runs[0].stats.links_added);
+  }
+}
+
+// RefineOptions::drop_dead_tet_events: a tet's Skinny event leaves the queue
+// when the tet is destroyed instead of waiting to be popped stale. The live
+// events keep their order, so the refinement is the same bit for bit, and
+// the events removed are exactly the tet events that were popped stale.
+TEST(CollarRefine, DroppedDeadTetEventsGiveTheSameRefinement) {
+  for (const SameRefinementCase& c :
+       {SameRefinementCase{"a_convex/cube.poly", false, 1e-4}, SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4},
+        SameRefinementCase{"e_spread/tiny_cube_in_box.poly", false, 1e-3}}) {
+    const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->drop_dead_tet_events = on; });
+    const int k = static_cast<int>(EventType::kSkinny);
+    EXPECT_EQ(runs[0].stats.events_removed_dead[k], 0u) << c.rel;
+    EXPECT_GT(runs[1].stats.events_removed_dead[k], 1000u) << c.rel;
+    EXPECT_EQ(runs[1].stats.events_pushed[k], runs[0].stats.events_pushed[k]) << c.rel;
+    EXPECT_EQ(runs[1].stats.events_stale[k] + runs[1].stats.events_removed_dead[k], runs[0].stats.events_stale[k])
+        << c.rel;
+    std::printf("%s: %llu tet events removed when their tet died\n", c.rel,
+                (unsigned long long)runs[1].stats.events_removed_dead[k]);
   }
 }
 

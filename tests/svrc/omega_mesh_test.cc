@@ -72,7 +72,7 @@ Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool la
         if (a.dt().IsGhost(t)) continue;
         double x = 0;
         for (int i = 0; i < 4; ++i) x += a.dt().Point(a.dt().TetVertex(t, i)).x / 4;
-        labels[t.value()] = {a.dt().Generation(t) + 1, x > 0.45, false, HUGE_VAL};
+        labels[t.value()] = TetLabel::Make(a.dt().Generation(t) + 1, x > 0.45, 0);
       }
     }
     const std::vector<VertexId> cav(ra.cavity_vertices.begin(), ra.cavity_vertices.end());

@@ -187,6 +187,32 @@ TEST(WorkQueueTest, HandlesGoStaleAfterPopAndSlotReuse) {
 
 // Lemma 30: DecreaseSize moves the event to its new bucket, behind the events
 // already there, and costs the number of buckets between.
+// RemoveObjectEvent takes a slot number only: it removes the event there
+// when that event is the named object's, and nothing once the slot was
+// popped, or freed and reused by another object's event.
+TEST(WorkQueueTest, RemoveObjectEventRemovesOnlyThatObjectsEvent) {
+  WorkQueues q;
+  const EventHandle a = q.Enqueue(Ev(EventType::kSkinny, 3, 1.0, 10));
+  const EventHandle b = q.Enqueue(Ev(EventType::kSkinny, 3, 1.0, 11));
+  const EventHandle c = q.Enqueue(Ev(EventType::kSkinny, 3, 4.0, 12));
+  ASSERT_TRUE(a.valid() && b.valid() && c.valid());
+  EXPECT_FALSE(q.RemoveObjectEvent(b.id, MeshId(0), 10));  // b's slot holds 11's event
+  EXPECT_FALSE(q.RemoveObjectEvent(b.id, MeshId(1), 11));  // another mesh
+  EXPECT_FALSE(q.RemoveObjectEvent(EventId(), MeshId(0), 11));
+  EXPECT_TRUE(q.RemoveObjectEvent(b.id, MeshId(0), 11));
+  EXPECT_FALSE(q.IsQueued(b));
+  EXPECT_FALSE(q.RemoveObjectEvent(b.id, MeshId(0), 11));  // already gone
+  EXPECT_EQ(q.size(), 2u);
+  EXPECT_EQ(q.stats().removed_dead[static_cast<int>(EventType::kSkinny)], 1u);
+  // b's slot reused by object 13: 11's removal must not take it.
+  const EventHandle d = q.Enqueue(Ev(EventType::kSkinny, 3, 1.0, 13));
+  ASSERT_EQ(d.id, b.id);
+  EXPECT_FALSE(q.RemoveObjectEvent(d.id, MeshId(0), 11));
+  EXPECT_TRUE(q.Validate());
+  EXPECT_EQ(Drain(q), (std::vector<uint32_t>{12, 10, 13}));  // the rest keep their order
+  EXPECT_FALSE(q.RemoveObjectEvent(c.id, MeshId(0), 12));    // popped
+}
+
 TEST(WorkQueueTest, DecreaseSizeMovesBucketAndCountsWalk) {
   WorkQueues q;
   EventHandle big = q.Enqueue(Ev(EventType::kSkinny, 3, 64.0, 1));   // bucket 6
