@@ -1944,10 +1944,7 @@ bool Refiner::EnqueueTetIfBad(TetId t) {
   const EventHandle h =
       queues_.Enqueue({EventType::kSkinny, 3, kOmegaMesh, t.value() | kTetEvent, omega_.dt().Generation(t), r});
   if (h.valid() && options_.drop_dead_tet_events) {
-    if (tet_event_.size() <= t.value()) {
-      const uint32_t cap = omega_.dt().TetCapacity();
-      util::GrowExactly(tet_event_, cap + cap / 2, kNoTetEvent);
-    }
+    util::GrowExactly(tet_event_, omega_.dt().TetCapacity(), kNoTetEvent);  // one per slot, as the tets
     tet_event_[t.value()] = h.id.value();
   }
   return true;
@@ -1988,7 +1985,7 @@ void Refiner::PropagateSizeTargets(const delaunay::Delaunay3::InsertResult& inse
       created_labels_[k] = tet_labels_[d.value()];
     }
   }
-  if (tet_labels_.size() < dt.TetCapacity()) util::GrowExactly(tet_labels_, dt.TetCapacity() + dt.TetCapacity() / 2);
+  if (tet_labels_.size() < dt.TetCapacity()) util::GrowExactly(tet_labels_, dt.TetCapacity());
   if (size_target_.size() < dt.NumVertices()) util::GrowExactly(size_target_, dt.NumVertices() + dt.NumVertices() / 2 + 16, HUGE_VAL);
   for (size_t k = 0; k < n; ++k) {
     const TetId c = inserted.created[k];
@@ -3181,7 +3178,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const bool relabel = !tet_ids.empty() && options_.propagate_size_targets;
   const size_t old_labels = relabel && options_.skip_unchanged_tets ? tet_labels_.size() : 0;
   if (relabel) {
-    tet_labels_.resize(dt.TetCapacity() + dt.TetCapacity() / 2);
+    tet_labels_.resize(dt.TetCapacity());
   } else {
     tet_labels_.clear();
   }
