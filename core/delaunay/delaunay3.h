@@ -258,6 +258,8 @@ class Delaunay3 {
 
   uint32_t NewTet();
   void GrowTets();
+  // Room for one more vertex in the per-vertex arrays (a quarter more when full).
+  void ReserveVertex();
   void FreeTet(uint32_t t);
   bool ConflictRaw(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;
   bool ConflictSlow(uint32_t t, const Vec3& p, uint32_t gid, uint32_t* sos_used) const;

@@ -35,10 +35,19 @@ void OmegaMesh::SeedCorners(const std::array<PointId, 8>& ids) {
 
 void OmegaMesh::AddVertex(VertexId v, PointId p) {
   if (point_of_.size() <= v.value()) {
-    point_of_.resize(v.value() + 1);
-    cell_gen_.resize(v.value() + 1, 0);
-    skinny_event_.resize(v.value() + 1);
-    unresolved_event_.resize(v.value() + 1);
+    // A quarter more at a time (resize past the capacity would double it).
+    const size_t n = v.value() + 1;
+    if (point_of_.capacity() < n) {
+      const size_t cap = n + n / 4 + 16;
+      point_of_.reserve(cap);
+      cell_gen_.reserve(cap);
+      skinny_event_.reserve(cap);
+      unresolved_event_.reserve(cap);
+    }
+    point_of_.resize(n);
+    cell_gen_.resize(n, 0);
+    skinny_event_.resize(n);
+    unresolved_event_.resize(n);
   }
   point_of_[v.value()] = p;
   ++cell_gen_[v.value()];

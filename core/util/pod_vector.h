@@ -117,7 +117,7 @@ class PodVector {
   void push_back(const T& v) {
     if (size_ == cap_) {
       const T copy = v;  // v may live in this array
-      reserve(cap_ < 8 ? 8 : 2 * cap_);
+      reserve(cap_ + cap_ / 4 + 16);  // 1.25x: realloc grows a large block in place (mremap)
       new (data_ + size_++) T(copy);
       return;
     }
