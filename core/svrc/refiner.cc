@@ -3326,9 +3326,9 @@ absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
     if (!dt.IsAlive(t) || dt.IsGhost(t)) continue;
     // TetLabel::sliver_clear: set below on every live label a round reads,
     // so the first round leaves none stale; new tets' labels start clear of it.
-    TetLabel& label = tet_labels_[t.value()];
+    TetLabel& label = tet_labels_[t.value()];  // *lab
     label.set_sliver_clear(true);  // until a test below keeps it
-    if (!lab->kept()) continue;
+    if (!label.kept()) continue;
     std::array<Vec3, 4> x;
     for (int k = 0; k < 4; ++k) x[k] = dt.Point(dt.TetVertex(t, k));
     if (Volume6(x) > LongestEdgeCubed(x) * sin_min) continue;
