@@ -195,14 +195,19 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // of the labelling). Two records: the tets are neighbours; more: not a
   // tetrahedralization (reported for the smallest (a, b, c), with its three
   // smallest slots).
-  const bool given = in.neighbor_slot != nullptr && in.find_face != nullptr;
+  const bool given = in.neighbor_slots_of != nullptr && in.find_face != nullptr;
   std::optional<TetFaces> tet_faces;
   std::vector<uint32_t> own_nbr;
   if (!given) {
     tet_faces.emplace(in.tets, nv);
     own_nbr.assign(4 * nt, kNoTet);
   }
-  auto nbr = [&](uint32_t s) { return given ? in.neighbor_slot(s) : own_nbr[s]; };
+  // The four slots facing tet t's (one call per tet when given).
+  auto nbr4 = [&](uint32_t t) -> std::array<uint32_t, 4> {
+    if (given) return in.neighbor_slots_of(t);
+    return {own_nbr[4 * t], own_nbr[4 * t + 1], own_nbr[4 * t + 2], own_nbr[4 * t + 3]};
+  };
+  auto nbr = [&](uint32_t s) { return nbr4(s / 4)[s % 4]; };
   if (!given) {
     TetFaces::Overused bad;
     if (!tet_faces->Match(
@@ -297,10 +302,11 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       const uint32_t t = stack.back();
       stack.pop_back();
       ++comp.num_tets;
+      const std::array<uint32_t, 4> n4 = nbr4(t);
       for (int f = 0; f < 4; ++f) {
         const uint32_t s = 4 * t + f;
         if ((constrained_slot[s >> 6] >> (s & 63) & 1) != 0) continue;
-        const uint32_t other = nbr(s);
+        const uint32_t other = n4[f];
         if (other == kNoTet) {
           comp.touches_box = true;
           continue;

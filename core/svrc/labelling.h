@@ -45,15 +45,15 @@ struct LabelInput {
   // the exterior nor hole components are dropped.
   bool keep_bounding_box = false;
   // Optional, from a caller that already has the adjacency (the refiner's
-  // Delaunay3): a function giving, for slot 4t + f (the face opposite local
-  // vertex f of tet t), the slot of the same face in the other tet, or
+  // Delaunay3): a function giving, for tet t and each f, the slot 4u + g of
+  // the face opposite local vertex f (slot 4t + f) in the other tet u, or
   // kNoTet; and one giving some slot of the face with vertices {a, b, c}, or
   // kNoTet. With both, the face table (TetFaces: 64 bytes per tet, the peak
   // of a small run's size round, docs/svrc-design.md §8 item 43) is not built
   // and the tets are trusted to form a tetrahedralization. The labelling is
   // the same. (Functions, not arrays: the refiner's array of neighbour slots,
   // 16 bytes per tet, was a fifth of the labelling's peak; session 29.)
-  std::function<uint32_t(uint32_t)> neighbor_slot;
+  std::function<std::array<uint32_t, 4>(uint32_t)> neighbor_slots_of;
   std::function<uint32_t(uint32_t, uint32_t, uint32_t)> find_face;
 };
 

@@ -3140,11 +3140,14 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   if (!tet_ids.empty() && options_.label_with_adjacency) {
     compact.assign(dt.TetCapacity(), kNoTet);
     for (uint32_t i = 0; i < tet_ids.size(); ++i) compact[tet_ids[i].value()] = i;
-    in.neighbor_slot = [&](uint32_t s) -> uint32_t {
-      const TetId t = tet_ids[s >> 2];
-      const int f = static_cast<int>(s & 3);
-      const TetId n = dt.Neighbor(t, f);
-      return dt.IsGhost(n) ? kNoTet : 4 * compact[n.value()] + dt.NeighborFace(t, f);
+    in.neighbor_slots_of = [&](uint32_t i) {
+      const TetId t = tet_ids[i];
+      std::array<uint32_t, 4> out;
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = dt.Neighbor(t, f);
+        out[f] = dt.IsGhost(n) ? kNoTet : 4 * compact[n.value()] + dt.NeighborFace(t, f);
+      }
+      return out;
     };
     in.find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
       dt.Star(VertexId(a), &star);

@@ -117,7 +117,7 @@ TEST(LabellingTest, NestedBoxesTwoRegionsAndAHole) {
   EXPECT_TRUE(l->components[0].touches_box);  // tet 0 is at the grid corner
 }
 
-// The caller's adjacency (LabelInput::neighbor_slot and find_face, as the
+// The caller's adjacency (LabelInput::neighbor_slots_of and find_face, as the
 // refiner's size rounds pass them from Delaunay3) gives the labelling the
 // face table gives, field for field — the faces' first tet included, though
 // find_face here answers with the larger of a face's two slots.
@@ -145,7 +145,9 @@ TEST(LabellingTest, GivenAdjacencyGivesTheSameLabelling) {
     }
   }
   LabelInput in = nb.Input(seeds, holes);
-  in.neighbor_slot = [&](uint32_t s) { return nbr[s]; };
+  in.neighbor_slots_of = [&](uint32_t t) {
+    return std::array<uint32_t, 4>{nbr[4 * t], nbr[4 * t + 1], nbr[4 * t + 2], nbr[4 * t + 3]};
+  };
   in.find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
     std::array<uint32_t, 3> k{a, b, c};
     std::sort(k.begin(), k.end());
