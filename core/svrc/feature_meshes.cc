@@ -36,14 +36,11 @@ void OmegaMesh::SeedCorners(const std::array<PointId, 8>& ids) {
 void OmegaMesh::AddVertex(VertexId v, PointId p) {
   if (point_of_.size() <= v.value()) {
     // A quarter more at a time (resize past the capacity would double it).
-    const size_t n = v.value() + 1;
-    if (point_of_.capacity() < n) {
-      const size_t cap = n + n / 4 + 16;
-      point_of_.reserve(cap);
-      cell_gen_.reserve(cap);
-      skinny_event_.reserve(cap);
-      unresolved_event_.reserve(cap);
-    }
+    const size_t n = v.value() + 1, extra = n - point_of_.size();
+    util::ReserveForAppend(point_of_, extra);
+    util::ReserveForAppend(cell_gen_, extra);
+    util::ReserveForAppend(skinny_event_, extra);
+    util::ReserveForAppend(unresolved_event_, extra);
     point_of_.resize(n);
     cell_gen_.resize(n, 0);
     skinny_event_.resize(n);

@@ -263,7 +263,10 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       uint32_t first_slot = kNoTet;
       if (given) {
         const uint32_t s = in.find_face(k[0], k[1], k[2]);
-        if (s != kNoTet) first_slot = nbr(s) != kNoTet ? std::min(s, nbr(s)) : s;
+        if (s != kNoTet) {
+          const uint32_t other = nbr(s);
+          first_slot = other != kNoTet ? std::min(s, other) : s;
+        }
       } else {
         for (const TetFace& f : tet_faces->Bucket(k[0])) {
           if (f.b == k[1] && f.c == k[2]) {
