@@ -3642,6 +3642,8 @@ void Refiner::FillCounters(RefineStats* out) const {
     st.events_stale[i] = q.stale[i];
     st.events_removed_dead[i] = q.removed_dead[i];
   }
+  st.ball_records = balls_.size();
+  st.balls_alive = balls_.NumAlive();
   st.buckets_walked = q.buckets_walked;
   st.max_bucket_walk = q.max_walk_one_op;
   st.links_added = blg_.stats().links_added;
@@ -3813,6 +3815,8 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.slivers_broken", static_cast<double>(slivers_broken));
   out->Set("svrc.sliver_scan_reused", static_cast<double>(sliver_scan_reused));
   out->Set("svrc.tied_balls", static_cast<double>(tied_balls));
+  out->Set("svrc.ball_records", static_cast<double>(ball_records));
+  out->Set("svrc.balls_alive", static_cast<double>(balls_alive));
   out->Set("svrc.phantom_corners", static_cast<double>(phantom_corners));
   out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
   out->Set("svrc.links_added", static_cast<double>(links_added));

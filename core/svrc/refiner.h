@@ -314,6 +314,10 @@ struct RefineStats {
   uint64_t duplicates = 0;         // warp targets equal to an existing vertex
   uint64_t phantom_corners = 0;    // clipped cell corners equal to an existing vertex (skipped)
   uint64_t tied_balls = 0;         // pieces/triangles missing at the end (ties), re-enqueued
+  // Ball records at the end, and how many are alive: ball ids are never
+  // reused, so the dead ones (and their per-id side arrays) stay allocated.
+  uint64_t ball_records = 0;
+  uint64_t balls_alive = 0;
   uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first
   uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run
   uint64_t labels_unchanged = 0;   // tets a size round relabelled as they were: not retested

@@ -577,6 +577,9 @@ TEST(CollarRefine, DroppedDeadTetEventsGiveTheSameRefinement) {
     EXPECT_EQ(runs[1].stats.events_pushed[k], runs[0].stats.events_pushed[k]) << c.rel;
     EXPECT_EQ(runs[1].stats.events_stale[k] + runs[1].stats.events_removed_dead[k], runs[0].stats.events_stale[k])
         << c.rel;
+    // Ball records: split facet triangles leave dead ones (ids are not reused).
+    EXPECT_GT(runs[1].stats.balls_alive, 0u) << c.rel;
+    EXPECT_GT(runs[1].stats.ball_records, runs[1].stats.balls_alive) << c.rel;
     std::printf("%s: %llu tet events removed when their tet died\n", c.rel,
                 (unsigned long long)runs[1].stats.events_removed_dead[k]);
   }
