@@ -343,6 +343,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     options.collar_surface = true;
     options.max_rep_angle = params.max_rep_angle * M_PI / 180;
     options.collar_size_eps = params.collar_size_eps;
+    options.collar_tet_quality = params.collar_tet_quality;
   } else if (!crease.empty()) {
     options.attempt_creases = true;
     options.max_vertices = CreaseBudget(*complex, params);

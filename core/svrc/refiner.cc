@@ -158,6 +158,15 @@ class Refiner {
   void ServeSkinnyTetsNewestFirst() { queues_.SetNewestFirst(EventType::kSkinny, 3, true); }
   bool tet_mode_ = false;
   bool tet_sizes_ = false;
+  // RefineOptions::collar_tet_quality: tet_mode_ without labels (TetBad).
+  bool collar_tets_ = false;
+  // collar_tets_: enqueues every bad tet of M_Ω (after the features conform).
+  void EnqueueBadTets() {
+    const delaunay::Delaunay3& dt = omega_.dt();
+    for (uint32_t i = 0; i < dt.TetCapacity(); ++i) {
+      if (dt.IsAlive(TetId(i))) EnqueueTetIfBad(TetId(i));
+    }
+  }
  private:
   // End of the queues: a piece that is not an edge of M_Ω or of a facet mesh
   // containing it, or an in-facet triangle that is not a face of M_Ω, has a
@@ -1892,7 +1901,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
       if (queues_.IsQueued(ke)) queues_.Remove(ke);
     }
   }
-  if (tet_mode_ && !skinny_deferred_ && !tet_labels_.empty()) {
+  if (tet_mode_ && !skinny_deferred_ && (collar_tets_ || !tet_labels_.empty())) {
     for (TetId t : created_) EnqueueTetIfBad(t);
   }
   // Figure 3.5 lines 5–7: a crease point from a lower feature gets its collar.
@@ -1902,9 +1911,21 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
 
 bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   const delaunay::Delaunay3& dt = omega_.dt();
-  const TetLabel* lab = dt.IsGhost(t) ? nullptr : LiveLabel(t);
-  if (lab == nullptr || !lab->kept()) return false;
+  if (dt.IsGhost(t)) return false;
+  const TetLabel* lab = LiveLabel(t);
+  if (collar_tets_ && lab == nullptr) {
+    // Unlabelled collar path: every tet, except those next to a crease (a
+    // crease vertex) and those the stitch replaces (below).
+    for (int k = 0; k < 4; ++k) {
+      if (points_.IsCrease(omega_.PointOf(dt.TetVertex(t, k)))) return false;
+    }
+  } else if (lab == nullptr || !lab->kept()) {
+    return false;
+  }
   if (!omega_.PlainCorner(t, cc)) return false;
+  // RipStitchCollar empties the tets whose circumcentre is strictly inside
+  // the collars (rip_stitch.h, step 1); every other tet stays in its output.
+  if (collar_tets_ && lab == nullptr && collars_.StrictlyInside(*cc)) return false;
   std::array<Vec3, 4> q;
   for (int k = 0; k < 4; ++k) q[k] = dt.Point(dt.TetVertex(t, k));
   const double r = geom::Dist(*cc, q[0]);
@@ -1915,7 +1936,7 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   *radius = r;
   const double rho = 0.5 * options_.tau;
   if (r * r > rho * rho * l2) return true;
-  if (!tet_sizes_) return false;
+  if (!tet_sizes_ || lab == nullptr) return false;
   if (options_.tet_volumes) {
     // The bound itself, with a relative margin of 1e-9 for the rounding of
     // this determinant and of the back map to input coordinates (the
@@ -3993,16 +4014,24 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   }
   const bool eligible = !options.collars && !options.keep_bounding_box && !complex.facets.empty() &&
                         options.propagate_size_targets;
-  const bool tet_quality = eligible && options.tet_quality;
-  const bool features_first = eligible && (tet_quality || options.features_first);
+  const bool collar_tets = options.collars && options.collar_tet_quality && !options.keep_bounding_box &&
+                           !complex.facets.empty();
+  const bool tet_quality = (eligible && options.tet_quality) || collar_tets;
+  const bool features_first = (eligible && (tet_quality || options.features_first)) || collar_tets;
   if (features_first) refiner.skinny_deferred_ = true;
   refiner.tet_mode_ = tet_quality;
+  refiner.collar_tets_ = collar_tets;
   // Skinny₃ buckets newest first (docs/svrc-design.md §8 item 52).
   if (tet_quality && options.newest_first_tets) refiner.ServeSkinnyTetsNewestFirst();
 
   s = refiner.Run();
   if (!s.ok()) return s;
-  if (features_first) {
+  if (collar_tets) {
+    refiner.skinny_deferred_ = false;
+    refiner.EnqueueBadTets();
+    s = refiner.Run();
+    if (!s.ok()) return s;
+  } else if (features_first) {
     refiner.skinny_deferred_ = false;
     // Every cell's Skinny test resumes on its kept tets (features_first alone);
     // under tet_quality the cells only carry size targets, which the
@@ -4048,7 +4077,7 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
     if (!s.ok()) return s;
   }
   // Slivers of the per-tet mode's output (§8 item 38), a few rounds.
-  for (int round = 0; tet_quality && options.sliver_break_deg > 0 && round < 4; ++round) {
+  for (int round = 0; tet_quality && !collar_tets && options.sliver_break_deg > 0 && round < 4; ++round) {
     absl::StatusOr<bool> more = refiner.BreakSlivers(options.sliver_break_deg, /*first=*/round == 0);
     if (!more.ok()) return more.status();
     if (!*more) break;
