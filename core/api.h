@@ -39,7 +39,7 @@ struct MeshParams {
   // the vertex budget, with 0.4–0.6× the tets at 2; not yet the default
   // (wedge-1 and knife_edge with max_volume fail; docs/svrc-collars.md
   // "Session 30"). Local API only (no CLI flag or job field yet).
-  bool collar_tet_quality = false;
+  bool collar_tet_quality = true;
   // Global max tet volume in input units³; <= 0: none.
   double max_volume = 0.0;
   // Sliver removal target in degrees (thesis §6.2.1); <= 0: off.

@@ -668,7 +668,15 @@ class Refiner {
   CollarIndex collars_;
   std::vector<PointId> collar_centre_;          // per collar
   std::vector<uint8_t> has_collar_;             // per point
-  std::vector<std::pair<Vec3, uint32_t>> stitch_failures_;  // (rep point on S, ball) of the last failed stitch
+  // The last failed stitch's repairable failures: a point of S and its
+  // collar dimension (2: a partial sphere's, an inverted star; 1: a crease
+  // circle's, a flat book), and the ball.
+  struct StitchRepair {
+    Vec3 x;
+    uint32_t ball = 0;
+    uint8_t collar_dim = 2;
+  };
+  std::vector<StitchRepair> stitch_failures_;
   std::vector<uint8_t> neck_point_;             // per point: SplitCollarNecks' points get a ball even inside a collar
   std::vector<uint8_t> suppressed_;             // per point: 1 once strictly inside a collar
   std::vector<std::vector<uint32_t>> point_segments_;  // per complex point: segments ending there
@@ -2491,11 +2499,11 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchFailures() {
   // inverted star at ball 7).
   const delaunay::Delaunay3& dt = omega_.dt();
   uint32_t inserted = 0;
-  for (const auto& [x, ball] : stitch_failures_) {
+  for (const auto& [x, ball, collar_dim] : stitch_failures_) {
     const VertexId v = dt.NearestVertex(x);
     const double r = geom::Dist(dt.Point(v), x);
     if (!(r > kMinCollarRepairRatio * collars_.ball(ball).radius)) continue;
-    absl::Status st = DestroyOmegaAt(x, r, dt.VertexTet(v), v, Cd{3, 2});
+    absl::Status st = DestroyOmegaAt(x, r, dt.VertexTet(v), v, Cd{3, collar_dim});
     if (!st.ok()) return st;
     ++collar_repairs_;
     ++inserted;
@@ -2940,7 +2948,12 @@ absl::Status Refiner::StitchImpl() {
   }
   stitch_failures_.clear();
   for (const StitchFailure& f : failures) {
-    if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.emplace_back(f.where, f.ball);
+    if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.push_back({f.where, f.ball, 2});
+    // A flat book (its two T′ points coplanar with the crease edge, as two
+    // points of one facet through the crease are): `where` is the crease
+    // circle's crossing of their edge's Voronoi facet, so inserting it
+    // removes that edge (wedge-1.smesh under collar_tet_quality).
+    if (f.kind == StitchFailure::Kind::kBookDegenerate) stitch_failures_.push_back({f.where, f.ball, 1});
   }
   if (!r.ok()) return r.status();
   // The tets to point ids in place, then moved: stitched_ grown by push_back
@@ -3246,7 +3259,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // against their own targets (§8 item 34).
   // A volume bound is tested per tet on the volume itself (tet_volumes).
   const bool bounded = !uniform || (first_volume >= 0 && first_volume != HUGE_VAL);
-  if (tet_mode_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
+  if (tet_mode_ && !collar_tets_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
   for (size_t t = 0; t < tets.size(); ++t) {
     const uint32_t c = lab->tet_component[t];
     const bool kept = lab->components[c].kept;

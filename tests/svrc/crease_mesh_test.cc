@@ -240,6 +240,7 @@ TEST(CreaseMesh, TightBoundOverBudgetSaysWhy) {
   absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/knife_edge.poly"));
   ASSERT_TRUE(plc.ok()) << plc.status();
   core::MeshParams params;
+  params.collar_tet_quality = false;  // the cell test of Figure 3.5 (with the per-tet test it meshes)
   params.max_vertices = 30000;
   params.radius_edge = 1.5;
   absl::StatusOr<mesh::TetMesh> tight = core::MeshPlc(*plc, params);
@@ -262,6 +263,7 @@ TEST(CreaseMesh, TightBoundCollarRoundsSayWhy) {
   GTEST_SKIP() << "release only";
 #endif
   core::MeshParams params;
+  params.collar_tet_quality = false;  // the cell test of Figure 3.5 (with the per-tet test it meshes)
   params.radius_edge = 1.5;
   absl::StatusOr<mesh::TetMesh> tight = core::MeshPlc(plc::families::CreaseFacetPair(30), params);
   ASSERT_FALSE(tight.ok());
