@@ -32,13 +32,15 @@ struct MeshParams {
   // the creases (docs/svrc-collars.md "Session 16" measures both). 0: the
   // angle test (default). At most 1.
   double collar_size_eps = 0.0;
-  // Experimental (issue #6): with collars, M_Ω's quality is tested per tet
-  // (radius-edge > radius_edge) instead of per Voronoi cell, skipping the
-  // tets next to a crease and those RipStitchCollar replaces. Meshes the
-  // crease inputs at radius_edge 1.5 and 1.414 where the cell test runs into
-  // the vertex budget, with 0.4–0.6× the tets at 2; not yet the default
-  // (wedge-1 and knife_edge with max_volume fail; docs/svrc-collars.md
-  // "Session 30"). Local API only (no CLI flag or job field yet).
+  // With collars, M_Ω's quality is tested per tet (radius-edge above
+  // radius_edge) instead of per Voronoi cell (Figure 3.5), skipping the tets
+  // with a crease vertex and those whose circumcentre is strictly inside the
+  // collars (RipStitchCollar replaces them); the size test stays per cell.
+  // The no-collar path has tested per tet since session 13. Since session 30
+  // (docs/svrc-collars.md "Session 30"): the crease inputs mesh at
+  // radius_edge 1.5 and 1.414, where the cell test does not settle; fewer
+  // tets at 2. false: the cell test. Local API only (no CLI flag or job
+  // field).
   bool collar_tet_quality = true;
   // Global max tet volume in input units³; <= 0: none.
   double max_volume = 0.0;

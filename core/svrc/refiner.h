@@ -66,13 +66,14 @@ struct RefineOptions {
   // features_first. PLCs with facets, no collars, no keep_bounding_box only
   // (the others keep the cell test).
   bool tet_quality = true;
-  // Experimental (issue #6, bounds below 2 on creased inputs): the per-tet
-  // test of tet_quality on the collar path. M_Ω is not labelled there (its
-  // flood leaks through the collars until the stitch), so every finite tet
-  // is tested except those with a crease vertex and those whose
-  // circumcentre is strictly inside the collars (RipStitchCollar empties
-  // them). docs/svrc-collars.md "Session 30". Off: the cell test of Figure
-  // 3.5 (MeshParams::collar_tet_quality).
+  // The per-tet test of tet_quality on the collar path (issue #6: bounds
+  // below 2 on creased inputs). M_Ω is not labelled there (its flood leaks
+  // through the collars until the stitch), so every finite tet is tested
+  // except those with a crease vertex and those whose circumcentre is
+  // strictly inside the collars (RipStitchCollar empties them); max_volume
+  // stays per cell. docs/svrc-collars.md "Session 30". core::MeshPlc sets it
+  // (MeshParams::collar_tet_quality, default on); off: the cell test of
+  // Figure 3.5.
   bool collar_tet_quality = false;
   // With tet_quality, max_volume is tested per output tet (circumradius >
   // the regular tet's of its region's bound) when the output's regions have
