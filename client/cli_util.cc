@@ -40,7 +40,7 @@ const std::vector<std::string>& MeshValueFlags() {
 }
 
 const std::vector<std::string>& MeshSwitches() {
-  static const std::vector<std::string> flags = {"--keep-bounding-box"};
+  static const std::vector<std::string> flags = {"--keep-bounding-box", "--collar-cell-test"};
   return flags;
 }
 
@@ -97,6 +97,7 @@ absl::StatusOr<MeshOptions> MeshOptionsFromArgs(const Args& args) {
     if (absl::Status s = ParseDouble(args, flag, field); !s.ok()) return s;
   }
   if (args.switches.count("--keep-bounding-box")) o.keep_bounding_box = true;
+  if (args.switches.count("--collar-cell-test")) o.collar_cell_test = true;
   if (args.values.count("--max-vertices") &&
       !absl::SimpleAtoi(args.Get("--max-vertices"), &o.max_vertices)) {
     return absl::InvalidArgumentError(

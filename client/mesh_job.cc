@@ -54,6 +54,7 @@ absl::StatusOr<core::MeshParams> ToMeshParams(const MeshOptions& o) {
   if (o.min_dihedral) p.min_dihedral = *o.min_dihedral;
   if (o.keep_bounding_box) p.keep_bounding_box = *o.keep_bounding_box;
   if (o.collar_size_eps) p.collar_size_eps = *o.collar_size_eps;
+  if (o.collar_cell_test) p.collar_tet_quality = !*o.collar_cell_test;
   p.max_vertices = o.max_vertices;
   return p;
 }
@@ -68,6 +69,7 @@ absl::Status CheckImplemented(const MeshOptions& o, const plc::Plc& plc) {
   if (o.min_dihedral && *o.min_dihedral > 0) set.push_back("min_dihedral");
   if (o.keep_bounding_box && *o.keep_bounding_box) set.push_back("keep_bounding_box");
   if (o.collar_size_eps && *o.collar_size_eps > 0) set.push_back("collar_size_eps");
+  if (o.collar_cell_test && *o.collar_cell_test) set.push_back("collar_cell_test");
   if (set.empty()) return absl::OkStatus();
   return absl::UnimplementedError(absl::StrCat(
       absl::StrJoin(set, ", "),

@@ -26,6 +26,7 @@ struct MeshOptions {
   std::optional<double> min_dihedral;
   std::optional<bool> keep_bounding_box;
   std::optional<double> collar_size_eps;
+  std::optional<bool> collar_cell_test;  // --collar-cell-test: MeshParams::collar_tet_quality = false
   uint64_t max_vertices = 0;                     // 0: the core's guard
   absl::Duration deadline = absl::ZeroDuration();  // 0: none
   int quantization_bits = 0;                     // 0: lossless

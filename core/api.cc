@@ -496,6 +496,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                             use_collars && params.collar_size_eps > 0
                                                 ? absl::StrCat(" collar_size_eps=", params.collar_size_eps)
                                                 : "",
+                                            use_collars && !params.collar_tet_quality ? " collar_cell_test=1" : "",
                                             " keep_bounding_box=", params.keep_bounding_box ? 1 : 0);
   mesh.provenance.input_sha256 = plc.input_sha256;
   mesh.stats.Set("tets", static_cast<double>(mesh.tets.size()));

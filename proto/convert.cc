@@ -44,6 +44,7 @@ absl::StatusOr<cli::MeshOptions> OptionsFromRequest(const v1::SubmitJobRequest& 
   if (p.has_min_dihedral()) o.min_dihedral = p.min_dihedral();
   if (p.has_keep_bounding_box()) o.keep_bounding_box = p.keep_bounding_box();
   if (p.has_collar_size_eps()) o.collar_size_eps = p.collar_size_eps();
+  if (p.has_collar_cell_test()) o.collar_cell_test = p.collar_cell_test();
   o.max_vertices = request.limits().max_vertices();
   if (request.limits().has_deadline()) {
     const auto& d = request.limits().deadline();
@@ -72,6 +73,7 @@ void OptionsToRequest(const cli::MeshOptions& o, v1::SubmitJobRequest* request) 
   if (o.min_dihedral) p->set_min_dihedral(*o.min_dihedral);
   if (o.keep_bounding_box) p->set_keep_bounding_box(*o.keep_bounding_box);
   if (o.collar_size_eps) p->set_collar_size_eps(*o.collar_size_eps);
+  if (o.collar_cell_test) p->set_collar_cell_test(*o.collar_cell_test);
   if (o.max_vertices > 0) request->mutable_limits()->set_max_vertices(o.max_vertices);
   if (o.deadline > absl::ZeroDuration()) {
     const int64_t ns = absl::ToInt64Nanoseconds(o.deadline);

@@ -108,24 +108,31 @@ TEST_F(CliTest, PlcLocalAndRemoteOutputsAreByteIdentical) {
 }
 
 // A creased input with a collar option (--collar-size-eps, the Ch. 6 size
-// criterion): the flag reaches the server's mesher (proto field
-// collar_size_eps), so local and remote .svrc outputs are byte-identical, and
-// they differ from the default criterion's.
+// criterion; --collar-cell-test, the thesis' cell test instead of the
+// per-tet test): the flag reaches the server's mesher (proto fields
+// collar_size_eps, collar_cell_test), so local and remote .svrc outputs are
+// byte-identical, and they differ from the defaults'.
 TEST_F(CliTest, CollarOptionLocalAndRemoteOutputsAreByteIdentical) {
   ASSERT_TRUE(server_->ok());
   const std::string dir = testing::MakeTempDir("cli_collar_identity");
   const std::string input = testing::CorpusPath("c_creases/knife_edge.poly");
-  const testing::CommandResult local =
-      RunSvrc({"mesh", input, "-o", dir + "/local.svrc", "--quiet", "--collar-size-eps", "0.3"});
-  ASSERT_EQ(local.exit_code, 0) << local.err;
-  const testing::CommandResult remote = RunSvrc({"submit", input, "--server", server_->address(), "--watch",
-                                                 "-o", dir + "/remote.svrc", "--collar-size-eps", "0.3"});
-  ASSERT_EQ(remote.exit_code, 0) << remote.err;
   const testing::CommandResult plain = RunSvrc({"mesh", input, "-o", dir + "/plain.svrc", "--quiet"});
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  const std::string a = testing::ReadFileOrFail(dir + "/local.svrc");
-  EXPECT_TRUE(a == testing::ReadFileOrFail(dir + "/remote.svrc"));
-  EXPECT_FALSE(a == testing::ReadFileOrFail(dir + "/plain.svrc"));
+  for (const std::vector<std::string>& flags :
+       {std::vector<std::string>{"--collar-size-eps", "0.3"}, std::vector<std::string>{"--collar-cell-test"}}) {
+    std::vector<std::string> mesh = {"mesh", input, "-o", dir + "/local.svrc", "--quiet"};
+    std::vector<std::string> submit = {"submit", input, "--server", server_->address(), "--watch",
+                                       "-o", dir + "/remote.svrc"};
+    mesh.insert(mesh.end(), flags.begin(), flags.end());
+    submit.insert(submit.end(), flags.begin(), flags.end());
+    const testing::CommandResult local = RunSvrc(mesh);
+    ASSERT_EQ(local.exit_code, 0) << flags[0] << ": " << local.err;
+    const testing::CommandResult remote = RunSvrc(submit);
+    ASSERT_EQ(remote.exit_code, 0) << flags[0] << ": " << remote.err;
+    const std::string a = testing::ReadFileOrFail(dir + "/local.svrc");
+    EXPECT_TRUE(a == testing::ReadFileOrFail(dir + "/remote.svrc")) << flags[0];
+    EXPECT_FALSE(a == testing::ReadFileOrFail(dir + "/plain.svrc")) << flags[0];
+  }
   EXPECT_EQ(RunSvrc({"mesh", input, "-o", dir + "/x.svrc", "--collar-size-eps", "1.5"}).exit_code, 2);
   fs::remove_all(dir);
 }
