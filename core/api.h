@@ -39,8 +39,8 @@ struct MeshParams {
   // The no-collar path has tested per tet since session 13. Since session 30
   // (docs/svrc-collars.md "Session 30"): the crease inputs mesh at
   // radius_edge 1.5 and 1.414, where the cell test does not settle; fewer
-  // tets at 2. false: the cell test. Local API only (no CLI flag or job
-  // field).
+  // tets at 2. false: the cell test (CLI --collar-cell-test, job field
+  // collar_cell_test).
   bool collar_tet_quality = true;
   // Global max tet volume in input units³; <= 0: none.
   double max_volume = 0.0;
