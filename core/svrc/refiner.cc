@@ -1921,9 +1921,10 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   const delaunay::Delaunay3& dt = omega_.dt();
   if (dt.IsGhost(t)) return false;
   const TetLabel* lab = LiveLabel(t);
-  if (collar_tets_ && lab == nullptr) {
-    // Unlabelled collar path: every tet, except those next to a crease (a
-    // crease vertex) and those the stitch replaces (below).
+  // The unlabelled collar path tests every tet, except those next to a
+  // crease (a crease vertex) and those the stitch replaces (below).
+  const bool unlabelled = collar_tets_ && lab == nullptr;
+  if (unlabelled) {
     for (int k = 0; k < 4; ++k) {
       if (points_.IsCrease(omega_.PointOf(dt.TetVertex(t, k)))) return false;
     }
@@ -1933,7 +1934,7 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   if (!omega_.PlainCorner(t, cc)) return false;
   // RipStitchCollar empties the tets whose circumcentre is strictly inside
   // the collars (rip_stitch.h, step 1); every other tet stays in its output.
-  if (collar_tets_ && lab == nullptr && collars_.StrictlyInside(*cc)) return false;
+  if (unlabelled && collars_.StrictlyInside(*cc)) return false;
   std::array<Vec3, 4> q;
   for (int k = 0; k < 4; ++k) q[k] = dt.Point(dt.TetVertex(t, k));
   const double r = geom::Dist(*cc, q[0]);
@@ -1944,7 +1945,7 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   *radius = r;
   const double rho = 0.5 * options_.tau;
   if (r * r > rho * rho * l2) return true;
-  if (!tet_sizes_ || lab == nullptr) return false;
+  if (!tet_sizes_ || unlabelled) return false;
   if (options_.tet_volumes) {
     // The bound itself, with a relative margin of 1e-9 for the rounding of
     // this determinant and of the back map to input coordinates (the
