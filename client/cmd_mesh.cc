@@ -25,8 +25,8 @@ int RunMesh(const std::vector<std::string>& argv);
 
 const Command kMesh{
     "mesh",
-    "mesh IN -o OUT [--radius-edge X] [--max-volume V] [--theta T] [--max-rep-angle A] [--collar-size-eps E] [--collar-cell-test] "
-    "[--min-dihedral D] [--keep-bounding-box] [--max-vertices N] [--deadline 30s] "
+    "mesh IN -o OUT [--radius-edge X] [--max-volume V] [--theta T] [--max-rep-angle A] [--collar-size-eps E] "
+    "[--collar-cell-test] [--min-dihedral D] [--keep-bounding-box] [--max-vertices N] [--deadline 30s] "
     "[--quantization-bits B] [--quiet] [--stats]   (OUT: .node .vtu .msh .mesh .svrc; --stats: "
     "the run's counters and the mesh quality)",
     &RunMesh};

@@ -1945,7 +1945,7 @@ bool Refiner::TetBad(TetId t, Vec3* cc, double* radius) const {
   *radius = r;
   const double rho = 0.5 * options_.tau;
   if (r * r > rho * rho * l2) return true;
-  if (!tet_sizes_ || unlabelled) return false;
+  if (!tet_sizes_) return false;  // never set on the collar path (SetSizeTargets)
   if (options_.tet_volumes) {
     // The bound itself, with a relative margin of 1e-9 for the rounding of
     // this determinant and of the back map to input coordinates (the
@@ -4026,12 +4026,12 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
     s = refiner.InsertCreaseVertices();
     if (!s.ok()) return s;
   }
-  const bool eligible = !options.collars && !options.keep_bounding_box && !complex.facets.empty() &&
-                        options.propagate_size_targets;
-  const bool collar_tets = options.collars && options.collar_tet_quality && !options.keep_bounding_box &&
-                           !complex.facets.empty();
+  // The per-tet test needs an output volume bounded by facets.
+  const bool faceted = !options.keep_bounding_box && !complex.facets.empty();
+  const bool eligible = !options.collars && faceted && options.propagate_size_targets;
+  const bool collar_tets = options.collars && options.collar_tet_quality && faceted;
   const bool tet_quality = (eligible && options.tet_quality) || collar_tets;
-  const bool features_first = (eligible && (tet_quality || options.features_first)) || collar_tets;
+  const bool features_first = tet_quality || (eligible && options.features_first);
   if (features_first) refiner.skinny_deferred_ = true;
   refiner.tet_mode_ = tet_quality;
   refiner.collar_tets_ = collar_tets;
