@@ -2278,8 +2278,24 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   // collar surface, and break the chain of consecutive balls RipStitchCollar
   // builds books from (measured on crease_pair_30: the vertex collar crossed
   // the ball of a non-adjacent crease point).
+  const bool point_12 = points_.CdOf(p).dim == 1 && points_.CdOf(p).collar == 2;
   if (!(p.value() < neck_point_.size() && neck_point_[p.value()]) && collars_.StrictlyInside(pos)) {
     ++stats_.collars_skipped_inside;
+    if (point_12) {
+      // On a vertex collar's sphere by construction: inside another ball
+      // means two creases' balls overlap (Lemma 13 broken by the estimate).
+      ++stats_.points_12_without_ball;
+      if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
+        const uint32_t in = collars_.FindContaining(pos);
+        const FeatureId fi = points_.Parent(collar_centre_[in]);
+        std::fprintf(stderr,
+                     "(1,2) point %u (segment %u) at (%.17g %.17g %.17g) strictly inside ball %u (dim %d idx %u, "
+                     "centre (%.17g %.17g %.17g) r %.17g): no ball\n",
+                     p.value(), features_.Index(points_.Parent(p)), pos.x, pos.y, pos.z, in, features_.Dim(fi),
+                     features_.Index(fi), collars_.ball(in).center.x, collars_.ball(in).center.y,
+                     collars_.ball(in).center.z, collars_.ball(in).radius);
+      }
+    }
     return absl::OkStatus();
   }
   // Figure 3.8 over M_Ω (guide: only M_Ω sees every feature's balls). A
@@ -2298,7 +2314,10 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   const CollarSizeResult g = FastCollarSize(dt, pos, nv, cell_features, feature_distance);
   stats_.collar_cells_explored += g.cells_explored;
   stats_.max_collar_cells = std::max<uint64_t>(stats_.max_collar_cells, g.cells_explored);
-  if (!std::isfinite(g.radius) || !(g.radius > 0)) return absl::OkStatus();
+  if (!std::isfinite(g.radius) || !(g.radius > 0)) {
+    if (point_12) ++stats_.points_12_without_ball;
+    return absl::OkStatus();
+  }
   const double rho = g.radius;
   collars_.Add(CollarBall{pos, rho});
   collar_centre_.push_back(p);
@@ -2358,7 +2377,15 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
       for (int k = 0; k < 64 && geom::InBall(m.PointAt(t), pos, rho) > 0; ++k) t = std::nextafter(t, at_a ? 1.0 : 0.0);
       uint32_t u = 0;
       while (m.Next(u) != SegmentMesh::kNil && m.T(m.Next(u)) <= t) u = m.Next(u);
-      if (m.Next(u) == SegmentMesh::kNil || m.T(u) == t || !(t > m.T(u) && t < m.T(m.Next(u)))) continue;
+      if (m.Next(u) == SegmentMesh::kNil || m.T(u) == t || !(t > m.T(u) && t < m.T(m.Next(u)))) {
+        ++stats_.points_12_skipped;
+        if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
+          std::fprintf(stderr, "(1,2) point of ball %u on segment %u at t %.17g not inserted (piece %.17g..%.17g)\n",
+                       collars_.size() - 1, sg, t, m.T(u),
+                       m.Next(u) == SegmentMesh::kNil ? -1.0 : m.T(m.Next(u)));
+        }
+        continue;
+      }
       ++stats_.points_12;
       absl::Status st = ForceInsertSegment(sg, u, t, Cd{1, 2});
       if (!st.ok()) return st;
@@ -2910,18 +2937,52 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
 
 absl::Status Refiner::StitchImpl() {
   const delaunay::Delaunay3& dt = omega_.dt();
-  std::vector<StitchBall> balls(collars_.size());
-  for (uint32_t i = 0; i < collars_.size(); ++i) {
-    balls[i].ball = collars_.ball(i);
-    balls[i].centre = VertexId(points_.VertexIn(collar_centre_[i], kOmegaMesh));
-  }
   // Crease edges: consecutive collared points along each crease segment.
   // Crease points without a ball between them lie on the book's axis and are
   // removed with the inside; those outside every collar break no pair whose
-  // spheres cross (the stitch ignores pairs that do not cross).
+  // spheres cross (the stitch ignores pairs that do not cross). A ball inside
+  // the union of its two chain neighbours is no part of S; it leaves the
+  // stitch's balls (its centre is then an inside vertex, removed), and the
+  // neighbours' circle is the crease edge (armadillo.off: a neck split's
+  // ball of radius 2.81e-4 under the 2.90e-4 circle it split, "spheres of
+  // balls 15048 and 26067 cross but are not a crease edge").
+  std::vector<std::vector<uint32_t>> chains;
+  {
+    uint32_t seg = std::numeric_limits<uint32_t>::max();
+    for (const CreaseBallPair& pr : CreaseBallPairs()) {
+      if (pr.seg != seg || chains.back().back() != pr.ball_u) {
+        chains.push_back({pr.ball_u});
+        seg = pr.seg;
+      }
+      chains.back().push_back(pr.ball_w);
+    }
+  }
+  std::vector<uint8_t> hidden(collars_.size(), 0);
+  for (std::vector<uint32_t>& chain : chains) {
+    for (uint32_t b : PruneHiddenChainBalls(collars_.balls(), &chain)) hidden[b] = 1;
+  }
+  // Stitch ball k is collar ball collar_of[k].
+  std::vector<uint32_t> collar_of, stitch_of(collars_.size(), CollarIndex::kNone);
+  std::vector<StitchBall> balls;
+  stats_.stitch_hidden_balls = 0;  // of this (the last) stitch
+  for (uint32_t i = 0; i < collars_.size(); ++i) {
+    if (hidden[i]) {
+      ++stats_.stitch_hidden_balls;
+      continue;
+    }
+    stitch_of[i] = static_cast<uint32_t>(balls.size());
+    collar_of.push_back(i);
+    StitchBall sb;
+    sb.ball = collars_.ball(i);
+    sb.centre = VertexId(points_.VertexIn(collar_centre_[i], kOmegaMesh));
+    balls.push_back(sb);
+  }
   std::vector<std::pair<uint32_t, uint32_t>> edges;
-  for (const CreaseBallPair& pr : CreaseBallPairs()) {
-    edges.emplace_back(std::min(pr.ball_u, pr.ball_w), std::max(pr.ball_u, pr.ball_w));
+  for (const std::vector<uint32_t>& chain : chains) {
+    for (size_t k = 1; k < chain.size(); ++k) {
+      const uint32_t a = stitch_of[chain[k - 1]], b = stitch_of[chain[k]];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
   }
   StitchInput in;
   in.dt = &dt;
@@ -2940,21 +3001,25 @@ absl::Status Refiner::StitchImpl() {
     for (const StitchFailure& f : failures) ++kinds[StitchFailureKindName(f.kind)];
     for (const auto& [k, n] : kinds) std::fprintf(stderr, "stitch failure %s: %d\n", k.c_str(), n);
     for (size_t i = 0; i < failures.size() && i < 5; ++i) std::fprintf(stderr, "  %s\n", failures[i].detail.c_str());
-    for (uint32_t i = 0; i < collars_.size(); ++i) {
+    // Stitch ball k (the failures' numbering) is collar ball collar_of[k].
+    for (uint32_t k = 0; k < balls.size(); ++k) {
+      const uint32_t i = collar_of[k];
       const FeatureId f = points_.Parent(collar_centre_[i]);
-      std::fprintf(stderr, "ball %u: feature dim %d idx %u centre (%g %g %g) r %g\n", i, features_.Dim(f),
-                   features_.Index(f), collars_.ball(i).center.x, collars_.ball(i).center.y, collars_.ball(i).center.z,
-                   collars_.ball(i).radius);
+      std::fprintf(stderr, "ball %u (collar %u): feature dim %d idx %u centre (%.17g %.17g %.17g) r %.17g\n", k, i,
+                   features_.Dim(f), features_.Index(f), collars_.ball(i).center.x, collars_.ball(i).center.y,
+                   collars_.ball(i).center.z, collars_.ball(i).radius);
     }
   }
   stitch_failures_.clear();
   for (const StitchFailure& f : failures) {
-    if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.push_back({f.where, f.ball, 2});
+    if (f.ball == StitchFailure::kNoBall) continue;
+    const uint32_t ball = collar_of[f.ball];
+    if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.push_back({f.where, ball, 2});
     // A flat book (its two T′ points coplanar with the crease edge, as two
     // points of one facet through the crease are): `where` is the crease
     // circle's crossing of their edge's Voronoi facet, so inserting it
     // removes that edge (wedge-1.smesh under collar_tet_quality).
-    if (f.kind == StitchFailure::Kind::kBookDegenerate) stitch_failures_.push_back({f.where, f.ball, 1});
+    if (f.kind == StitchFailure::Kind::kBookDegenerate) stitch_failures_.push_back({f.where, ball, 1});
   }
   if (!r.ok()) return r.status();
   // The tets to point ids in place, then moved: stitched_ grown by push_back
@@ -3869,6 +3934,9 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.vertex_collars", static_cast<double>(vertex_collars));
   out->Set("svrc.collars_skipped_inside", static_cast<double>(collars_skipped_inside));
   out->Set("svrc.points_12", static_cast<double>(points_12));
+  out->Set("svrc.points_12_skipped", static_cast<double>(points_12_skipped));
+  out->Set("svrc.points_12_without_ball", static_cast<double>(points_12_without_ball));
+  out->Set("svrc.stitch_hidden_balls", static_cast<double>(stitch_hidden_balls));
   out->Set("svrc.neck_splits", static_cast<double>(neck_splits));
   out->Set("svrc.collar_rounds", static_cast<double>(collar_rounds));
   if (collars > 0) {

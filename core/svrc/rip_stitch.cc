@@ -103,6 +103,34 @@ struct CreasePair {
 
 }  // namespace
 
+std::vector<uint32_t> PruneHiddenChainBalls(std::span<const CollarBall> balls, std::vector<uint32_t>* chain) {
+  std::vector<uint32_t> hidden;
+  std::vector<uint32_t>& c = *chain;
+  size_t k = 1;
+  while (k + 1 < c.size()) {
+    const CollarBall& b = balls[c[k]];
+    Circle3 circle;
+    bool hide = false;
+    if (SphereSphereCircle(balls[c[k - 1]], balls[c[k + 1]], &circle)) {
+      // Nearest point of the circle to b's centre: axial offset a, radial
+      // offset q from the circle's axis; squared distance a² + (h − q)².
+      const Vec3 v = b.center - circle.center;
+      const double a = geom::Dot(v, circle.normal);
+      const double q = geom::Norm(v - a * circle.normal);
+      const double dmin = circle.radius - q;
+      hide = a * a + dmin * dmin >= b.radius * b.radius;
+    }
+    if (!hide) {
+      ++k;
+      continue;
+    }
+    hidden.push_back(c[k]);
+    c.erase(c.begin() + static_cast<std::ptrdiff_t>(k));
+    if (k > 1) --k;
+  }
+  return hidden;
+}
+
 absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
                                              std::vector<StitchFailure>* failures) {
   if (in.dt == nullptr) return absl::InvalidArgumentError("RipStitchCollar: null triangulation");

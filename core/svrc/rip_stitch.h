@@ -100,6 +100,18 @@ struct StitchResult {
   StitchShape shape;
 };
 
+// Balls of one crease chain whose spheres are not on S. `chain` lists balls
+// (indices into `balls`) whose centres are consecutive along one crease
+// segment, its ends possibly vertex balls. An interior ball i whose two
+// neighbours in the chain cross in a circle that is nowhere strictly inside
+// ball i lies inside the union of the two (centres on one line; docs/
+// svrc-collars.md "Session 33"): its sphere is no part of S, the
+// neighbours' circle is, and their pair is the crease edge. Removes every
+// such ball from *chain (again after each removal: the new neighbours may
+// hide the next) and returns the removed ones in the order removed. The end
+// balls stay.
+std::vector<uint32_t> PruneHiddenChainBalls(std::span<const CollarBall> balls, std::vector<uint32_t>* chain);
+
 // Rip and stitch (see docs/svrc-collars.md "RipStitchCollar (stage f)"):
 //  1. A finite tet of dt is inside iff its circumcentre is strictly inside the
 //     union of the balls (geom::InBall on the constructed circumcentre: a

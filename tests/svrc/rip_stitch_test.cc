@@ -446,3 +446,83 @@ TEST(RipStitchTest, UnlistedCrossingPairIsRefused) {
 
 }  // namespace
 }  // namespace svrc::refine
+
+namespace svrc::refine {
+namespace {
+
+// A neck (|c₁c₂|² > r₁² + r₂², Lemma 14) split by a ball at the circle's
+// plane smaller than the circle: the split ball lies inside the union of
+// its two neighbours, so S has the neighbours' circle and no part of its
+// sphere (armadillo.off, session 33).
+void NeckScene(Scene* s, CollarBall* hidden) {
+  s->balls = {{Vec3(0, 0, 0), 1.0}, {Vec3(0, 0, 1.2), 0.5}, {Vec3(0, 0, 1.75), 0.45}};
+  s->crease_edges = {{0, 1}, {1, 2}};
+  // The circle of balls 0 and 1: plane z = (1.44 + 1 − 0.25) / 2.4 = 0.9125,
+  // radius √(1 − 0.9125²) = 0.409.
+  *hidden = {Vec3(0, 0, 0.9125), 0.35};
+}
+
+TEST(RipStitchTest, PruneHiddenChainBallsFindsTheBallUnderANeckCircle) {
+  Scene s;
+  CollarBall n;
+  NeckScene(&s, &n);
+  std::vector<CollarBall> balls = {s.balls[0], s.balls[1], s.balls[2], n};
+  std::vector<uint32_t> chain = {0, 3, 1, 2};
+  EXPECT_EQ(PruneHiddenChainBalls(balls, &chain), std::vector<uint32_t>{3});
+  EXPECT_EQ(chain, (std::vector<uint32_t>{0, 1, 2}));
+  // Larger than the circle (0.409): on S, kept.
+  balls[3].radius = 0.42;
+  chain = {0, 3, 1, 2};
+  EXPECT_TRUE(PruneHiddenChainBalls(balls, &chain).empty());
+  EXPECT_EQ(chain.size(), 4u);
+  // The ordinary chain keeps every ball.
+  Scene c;
+  ChainScene(&c);
+  chain = {0, 1, 2, 3};
+  EXPECT_TRUE(PruneHiddenChainBalls(c.balls, &chain).empty());
+  // The input that found it: armadillo.off's segment 70951 (normalised
+  // coordinates, printed to 6 digits by SVRC_COLLAR_DEBUG): collar balls
+  // 26032, 26067, the neck split's 26068 (radius 2.81e-4 under the 2.90e-4
+  // circle of its neighbours) and vertex ball 15048.
+  const std::vector<CollarBall> arm = {{Vec3(-0.299613, -0.348669, 0.0255977), 0.000467899},
+                                       {Vec3(-0.299827, -0.348748, 0.0251083), 0.000314692},
+                                       {Vec3(-0.299874, -0.348765, 0.0250004), 0.000280894},
+                                       {Vec3(-0.300266, -0.34891, 0.0241032), 0.00103175}};
+  chain = {0, 1, 2, 3};
+  EXPECT_EQ(PruneHiddenChainBalls(arm, &chain), std::vector<uint32_t>{2});
+  EXPECT_EQ(chain, (std::vector<uint32_t>{0, 1, 3}));
+}
+
+TEST(RipStitchTest, HiddenChainBallLeavesTheStitch) {
+  Scene s;
+  CollarBall n;
+  NeckScene(&s, &n);
+  BuildScene(&s, 0.2, 11);
+  const uint32_t vn = s.Add(n.center).value();
+  // With the hidden ball as a ball of the chain, the neighbours' circle is on
+  // S but no crease edge.
+  {
+    std::vector<StitchBall> balls = s.stitch_balls;
+    balls.push_back({n, VertexId(vn)});
+    const std::vector<Edge> edges = {{0, 3}, {1, 3}, {1, 2}};
+    StitchInput in = InputOf(s);
+    in.balls = balls;
+    in.crease_edges = edges;
+    std::vector<StitchFailure> fails;
+    const absl::StatusOr<StitchResult> r = RipStitchCollar(in, &fails);
+    ASSERT_FALSE(r.ok());
+    bool unlisted = false;
+    for (const StitchFailure& f : fails) unlisted |= f.kind == StitchFailure::Kind::kUnlistedCircle;
+    EXPECT_TRUE(unlisted) << Describe(fails);
+  }
+  // Pruned: its centre is an inside vertex, removed; the neck's circle gets
+  // its books.
+  std::vector<StitchFailure> fails;
+  const absl::StatusOr<StitchResult> r = RipStitchCollar(InputOf(s), &fails);
+  ASSERT_TRUE(r.ok()) << r.status() << "\n" << Describe(fails);
+  EXPECT_NE(std::find(r->removed_vertices.begin(), r->removed_vertices.end(), vn), r->removed_vertices.end());
+  CheckMesh(s, *r, "neck with a hidden ball");
+}
+
+}  // namespace
+}  // namespace svrc::refine
