@@ -414,6 +414,16 @@ Vec3 SegmentMesh::PointAt(double t) const {
   return pa_ + t * (pb_ - pa_);
 }
 
+double SegmentMesh::StepOutOfBall(double t, bool toward_b, const Vec3& c, double r) const {
+  double step = 0;
+  for (int k = 0; k < 1024 && geom::InBall(PointAt(t), c, r) > 0; ++k) {
+    const double next = std::nextafter(t, toward_b ? 1.0 : 0.0);
+    step = step == 0 ? std::fabs(next - t) : 2 * step;
+    t = toward_b ? std::min(1.0, t + step) : std::max(0.0, t - step);
+  }
+  return t;
+}
+
 double SegmentMesh::PieceLength(uint32_t v) const {
   return (t_[next_[v]] - t_[v]) * geom::Dist(pa_, pb_);
 }

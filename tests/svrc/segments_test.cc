@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/geometry/predicates.h"
+#include "core/svrc/feature_meshes.h"
 #include "core/svrc/refiner.h"
 #include "gtest/gtest.h"
 
@@ -174,6 +175,43 @@ TEST(SegmentsTest, DeterministicAndRejectsBadSegments) {
   EXPECT_EQ(RefinePointsAndSegments(pts, acute, {}).status().code(), absl::StatusCode::kUnimplemented);
   std::vector<SegmentInput> loop = {{1, 1}};
   EXPECT_EQ(RefinePointsAndSegments(pts, loop, {}).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace svrc::refine
+
+namespace svrc::refine {
+namespace {
+
+// The (1,2) point of a vertex collar (Figure 3.7 line 10) must not be
+// strictly inside the vertex's ball, or CreateCollar gives it no ball and the
+// vertex ball meets the next chain ball at a neck. armadillo.off's segment
+// 70951 (input vertices 22147 and 22518 scaled by 1/128, as normalised; the
+// vertex ball of 22147 with its radius from SVRC_COLLAR_DEBUG): the rounded
+// point at t = ρ/|ab| is inside, and 64 single ulp steps of t (the loop
+// until session 33) leave it inside; StepOutOfBall's doubling steps do not.
+TEST(SegmentMesh, StepOutOfBallLeavesTheVertexBallOfAShortSegment) {
+  const Vec3 v22147(-38.4341 / 128, -44.6605 / 128, 3.08521 / 128);
+  const Vec3 v22518(-38.2737 / 128, -44.6012 / 128, 3.45225 / 128);
+  const double rho = 0.0010317468755203655;
+  for (const bool vertex_at_a : {true, false}) {
+    const Vec3 pa = vertex_at_a ? v22147 : v22518, pb = vertex_at_a ? v22518 : v22147;
+    const SegmentMesh m(PointId(0), PointId(1), pa, pb);
+    const double len = geom::Dist(pa, pb);
+    const double t0 = vertex_at_a ? rho / len : 1 - rho / len;
+    ASSERT_GT(geom::InBall(m.PointAt(t0), v22147, rho), 0) << "rounding no longer puts the point inside";
+    if (vertex_at_a) {
+      double t = t0;
+      for (int k = 0; k < 64; ++k) t = std::nextafter(t, 1.0);
+      EXPECT_GT(geom::InBall(m.PointAt(t), v22147, rho), 0) << "64 single steps now suffice: find another input";
+    }
+    const double t = m.StepOutOfBall(t0, /*toward_b=*/vertex_at_a, v22147, rho);
+    EXPECT_LE(geom::InBall(m.PointAt(t), v22147, rho), 0) << vertex_at_a;
+    EXPECT_TRUE(vertex_at_a ? t > t0 : t < t0);
+    EXPECT_LT(std::fabs(t - t0), 1e-12);
+    // Already outside: unchanged.
+    EXPECT_EQ(m.StepOutOfBall(t, vertex_at_a, v22147, rho), t);
+  }
 }
 
 }  // namespace
