@@ -318,9 +318,10 @@ class SegmentMesh {
   // The point at parameter t: a + t(b − a), exactly a at 0 and b at 1.
   geom::Vec3 PointAt(double t) const;
   // t, or the parameter nearest t towards b (toward_b) or a whose point is
-  // not strictly inside B(c, r) (exact InBall): steps of 1, 2, 4, … ulps of
-  // t, at most 1024 (then the last one tried). One ulp of t moves a point of
-  // a short segment by far less than an ulp of its coordinates.
+  // not strictly inside B(c, r) (exact InBall): 64 steps of one ulp of t,
+  // then steps of 1, 2, 4, … ulps, at most 1024 in all (then the last one
+  // tried). One ulp of t moves a point of a short segment by far less than
+  // an ulp of its coordinates.
   double StepOutOfBall(double t, bool toward_b, const geom::Vec3& c, double r) const;
   // 3D length of the piece between consecutive vertices v and Next(v).
   double PieceLength(uint32_t v) const;
