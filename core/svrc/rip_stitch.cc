@@ -103,6 +103,18 @@ struct CreasePair {
 
 }  // namespace
 
+double StitchedTetFlatness(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  // Altitude over face k = 3V / area_k = |det| / (2 area_k); the smallest is
+  // over the largest face.
+  const double det = std::fabs(geom::Dot(b - a, geom::Cross(c - a, d - a)));
+  const double twice_area = std::max({geom::Norm(geom::Cross(b - a, c - a)), geom::Norm(geom::Cross(b - a, d - a)),
+                                      geom::Norm(geom::Cross(c - a, d - a)), geom::Norm(geom::Cross(c - b, d - b))});
+  const double longest = std::sqrt(std::max({geom::Dist2(a, b), geom::Dist2(a, c), geom::Dist2(a, d),
+                                             geom::Dist2(b, c), geom::Dist2(b, d), geom::Dist2(c, d)}));
+  if (!(twice_area > 0) || !(longest > 0)) return 0;
+  return det / twice_area / longest;
+}
+
 std::vector<uint32_t> PruneHiddenChainBalls(std::span<const CollarBall> balls, std::vector<uint32_t>* chain) {
   std::vector<uint32_t> hidden;
   std::vector<uint32_t>& c = *chain;
@@ -345,6 +357,11 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
       if (geom::Orient3d(P(star[0]), P(star[1]), P(star[2]), P(star[3])) <= 0) {
         fail(Kind::kStarInverted, bf.x, bf.ball,
              absl::StrCat("star of ball ", bf.ball, " over ", face_name, " is not positively oriented"));
+      } else if (const double fl = StitchedTetFlatness(P(star[0]), P(star[1]), P(star[2]), P(star[3]));
+                 fl < kFlatStitchedTet) {
+        fail(Kind::kStarInverted, bf.x, bf.ball,
+             absl::StrCat("star of ball ", bf.ball, " over ", face_name, " is flat (altitude ", fl,
+                          " of its longest edge)"));
       }
       faces.push_back(bf);
     }
@@ -464,6 +481,11 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     const int o = geom::Orient3d(P(v), P(w), P(a), P(b));
     if (o == 0) {
       fail(Kind::kBookDegenerate, xs[0], cp.i, absl::StrCat("book (", v, ", ", w, ", ", a, ", ", b, ") is flat"));
+      continue;
+    }
+    if (const double fl = StitchedTetFlatness(P(v), P(w), P(a), P(b)); fl < kFlatStitchedTet) {
+      fail(Kind::kBookDegenerate, xs[0], cp.i,
+           absl::StrCat("book (", v, ", ", w, ", ", a, ", ", b, ") is flat (altitude ", fl, " of its longest edge)"));
       continue;
     }
     if (o < 0) std::swap(bk.tet[2], bk.tet[3]);

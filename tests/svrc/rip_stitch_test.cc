@@ -526,3 +526,31 @@ TEST(RipStitchTest, HiddenChainBallLeavesTheStitch) {
 
 }  // namespace
 }  // namespace svrc::refine
+
+namespace svrc::refine {
+namespace {
+
+// The star that over-covered a facet of armadillo.off (session 34, a run
+// with every (1,2) point stepped by doubling): ball centre = input vertex
+// 18068, its T′ face (three points of facet 9460), output coordinates as the
+// refused mesh was dumped. Orient3d is positive, but the four points lie on
+// the facet's plane within 1.7e-13, so all four faces counted as the facet's
+// and the checker found it covered 1.2132 of 1.0988. The stitch now refuses
+// the star as flat (repaired as an inverted one).
+TEST(RipStitchTest, FlatStarFromArmadilloIsRefused) {
+  const Vec3 c(-5.6970999999999998, -0.020401800000000001, 40.214799999999997);
+  const Vec3 a(-5.7364019911771518, -0.27833771839876031, 40.519769688800025);
+  const Vec3 b(-5.8058945718646475, -0.53122204016648034, 40.388316931337513);
+  const Vec3 d(-5.7935405589433611, -0.3998141619699821, 40.12632642330879);
+  ASSERT_NE(geom::Orient3d(c, a, b, d), 0) << "no longer positive by rounding: the test shows nothing";
+  EXPECT_LT(StitchedTetFlatness(c, a, b, d), kFlatStitchedTet);
+  // Scale does not matter; a regular tet is √(2/3); a thin but real sliver passes.
+  const Vec3 r0(1, 1, 1), r1(1, -1, -1), r2(-1, 1, -1), r3(-1, -1, 1);
+  EXPECT_NEAR(StitchedTetFlatness(r0, r1, r2, r3), std::sqrt(2.0 / 3), 1e-12);
+  EXPECT_NEAR(StitchedTetFlatness(1e-6 * r0, 1e-6 * r1, 1e-6 * r2, 1e-6 * r3), std::sqrt(2.0 / 3), 1e-12);
+  EXPECT_GT(StitchedTetFlatness(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.3, 0.3, 1e-6)), kFlatStitchedTet);
+  EXPECT_EQ(StitchedTetFlatness(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.3, 0.3, 0)), 0);
+}
+
+}  // namespace
+}  // namespace svrc::refine
