@@ -3019,12 +3019,20 @@ absl::Status Refiner::StitchImpl() {
   for (const StitchFailure& f : failures) {
     if (f.ball == StitchFailure::kNoBall) continue;
     const uint32_t ball = collar_of[f.ball];
-    if (f.kind == StitchFailure::Kind::kStarInverted) stitch_failures_.push_back({f.where, ball, 2});
+    // A flat star (a T′ face in a facet through its ball's centre, positive
+    // by rounding; armadillo.off under the snap band) is repaired as an
+    // inverted one: the point at its face's crossing of S removes the face.
+    if (f.kind == StitchFailure::Kind::kStarFlat || f.kind == StitchFailure::Kind::kBookFlat) ++stats_.stitch_flat_tets;
+    if (f.kind == StitchFailure::Kind::kStarInverted || f.kind == StitchFailure::Kind::kStarFlat) {
+      stitch_failures_.push_back({f.where, ball, 2});
+    }
     // A flat book (its two T′ points coplanar with the crease edge, as two
     // points of one facet through the crease are): `where` is the crease
     // circle's crossing of their edge's Voronoi facet, so inserting it
     // removes that edge (wedge-1.smesh under collar_tet_quality).
-    if (f.kind == StitchFailure::Kind::kBookDegenerate) stitch_failures_.push_back({f.where, ball, 1});
+    if (f.kind == StitchFailure::Kind::kBookDegenerate || f.kind == StitchFailure::Kind::kBookFlat) {
+      stitch_failures_.push_back({f.where, ball, 1});
+    }
   }
   if (!r.ok()) return r.status();
   // The tets to point ids in place, then moved: stitched_ grown by push_back
@@ -3942,6 +3950,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.points_12_skipped", static_cast<double>(points_12_skipped));
   out->Set("svrc.points_12_without_ball", static_cast<double>(points_12_without_ball));
   out->Set("svrc.stitch_hidden_balls", static_cast<double>(stitch_hidden_balls));
+  out->Set("svrc.stitch_flat_tets", static_cast<double>(stitch_flat_tets));
   out->Set("svrc.neck_splits", static_cast<double>(neck_splits));
   out->Set("svrc.collar_rounds", static_cast<double>(collar_rounds));
   if (collars > 0) {

@@ -27,9 +27,11 @@ const char* StitchFailureKindName(Kind kind) {
     case Kind::kLargeAngle: return "large_angle";
     case Kind::kCoarseSample: return "coarse_sample";
     case Kind::kStarInverted: return "star_inverted";
+    case Kind::kStarFlat: return "star_flat";
     case Kind::kNonManifoldEdge: return "non_manifold_edge";
     case Kind::kCircleCrossing: return "circle_crossing";
     case Kind::kBookDegenerate: return "book_degenerate";
+    case Kind::kBookFlat: return "book_flat";
     case Kind::kFaceMismatch: return "face_mismatch";
     case Kind::kVertexOutsideCollars: return "vertex_outside_collars";
     case Kind::kCreaseVertexUnused: return "crease_vertex_unused";
@@ -359,7 +361,7 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
              absl::StrCat("star of ball ", bf.ball, " over ", face_name, " is not positively oriented"));
       } else if (const double fl = StitchedTetFlatness(P(star[0]), P(star[1]), P(star[2]), P(star[3]));
                  fl < kFlatStitchedTet) {
-        fail(Kind::kStarInverted, bf.x, bf.ball,
+        fail(Kind::kStarFlat, bf.x, bf.ball,
              absl::StrCat("star of ball ", bf.ball, " over ", face_name, " is flat (altitude ", fl,
                           " of its longest edge)"));
       }
@@ -484,7 +486,7 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
       continue;
     }
     if (const double fl = StitchedTetFlatness(P(v), P(w), P(a), P(b)); fl < kFlatStitchedTet) {
-      fail(Kind::kBookDegenerate, xs[0], cp.i,
+      fail(Kind::kBookFlat, xs[0], cp.i,
            absl::StrCat("book (", v, ", ", w, ", ", a, ", ", b, ") is flat (altitude ", fl, " of its longest edge)"));
       continue;
     }

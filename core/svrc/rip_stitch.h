@@ -62,10 +62,12 @@ struct StitchFailure {
     kMultipleCrossings,      // ... meets S more than once (Definition 30 violated)
     kLargeAngle,             // representation angle > options.max_rep_angle
     kCoarseSample,           // RepBall > options.max_rep_ratio · css(x)
-    kStarInverted,           // Orient3d(star) ≤ 0, or flat (StitchedTetFlatness < kFlatStitchedTet)
+    kStarInverted,           // Orient3d(star) ≤ 0
+    kStarFlat,               // Orient3d(star) > 0 but StitchedTetFlatness < kFlatStitchedTet
     kNonManifoldEdge,        // an edge of T′ in ≠ 2 faces of T′
     kCircleCrossing,         // T′ edge vs circle disagreement (0/2 crossings, wrong pair)
-    kBookDegenerate,         // Orient3d(book) = 0, or flat (as a star)
+    kBookDegenerate,         // Orient3d(book) = 0
+    kBookFlat,               // Orient3d(book) ≠ 0 but StitchedTetFlatness < kFlatStitchedTet
     kFaceMismatch,           // exact face matching failed (a face not shared properly)
     kVertexOutsideCollars,   // a vertex only on inside tets is not strictly inside a ball
     kCreaseVertexUnused,     // a crease vertex in no stitched tet
@@ -115,8 +117,8 @@ std::vector<uint32_t> PruneHiddenChainBalls(std::span<const CollarBall> balls, s
 // A stitched tet's smallest altitude over its longest edge (0 for a flat
 // tet, √(2/3) for a regular one). A star or book whose four vertices lie on
 // one plane up to rounding can still have Orient3d > 0; the stitch refuses
-// it below kFlatStitchedTet (star_inverted / book_degenerate, repaired as
-// those). Such a star lay on a facet through its ball's centre on
+// it below kFlatStitchedTet (star_flat / book_flat, repaired as an inverted
+// star / a degenerate book). Such a star lay on a facet through its ball's centre on
 // armadillo.off (session 34): its four faces were all on the facet within the
 // checker's tolerance, so the facet was counted twice over the tet's area
 // ("facet_not_covered ... cover area 1.2132, facet area 1.0988").
