@@ -542,7 +542,7 @@ TEST(RipStitchTest, FlatStarFromArmadilloIsRefused) {
   const Vec3 a(-5.7364019911771518, -0.27833771839876031, 40.519769688800025);
   const Vec3 b(-5.8058945718646475, -0.53122204016648034, 40.388316931337513);
   const Vec3 d(-5.7935405589433611, -0.3998141619699821, 40.12632642330879);
-  ASSERT_NE(geom::Orient3d(c, a, b, d), 0) << "no longer positive by rounding: the test shows nothing";
+  ASSERT_GT(geom::Orient3d(c, a, b, d), 0) << "no longer positive by rounding: the test shows nothing";
   EXPECT_LT(StitchedTetFlatness(c, a, b, d), kFlatStitchedTet);
   // Scale does not matter; a regular tet is √(2/3); a thin but real sliver passes.
   const Vec3 r0(1, 1, 1), r1(1, -1, -1), r2(-1, 1, -1), r3(-1, -1, 1);
