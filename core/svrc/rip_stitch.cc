@@ -360,7 +360,7 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
         fail(Kind::kStarInverted, bf.x, bf.ball,
              absl::StrCat("star of ball ", bf.ball, " over ", face_name, " is not positively oriented"));
       } else if (const double fl = StitchedTetFlatness(P(star[0]), P(star[1]), P(star[2]), P(star[3]));
-                 fl < kFlatStitchedTet) {
+                 fl < in.options.min_flatness) {
         fail(Kind::kStarFlat, bf.x, bf.ball,
              absl::StrCat("star of ball ", bf.ball, " over ", face_name, " is flat (altitude ", fl,
                           " of its longest edge)"));
@@ -485,7 +485,7 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
       fail(Kind::kBookDegenerate, xs[0], cp.i, absl::StrCat("book (", v, ", ", w, ", ", a, ", ", b, ") is flat"));
       continue;
     }
-    if (const double fl = StitchedTetFlatness(P(v), P(w), P(a), P(b)); fl < kFlatStitchedTet) {
+    if (const double fl = StitchedTetFlatness(P(v), P(w), P(a), P(b)); fl < in.options.min_flatness) {
       fail(Kind::kBookFlat, xs[0], cp.i,
            absl::StrCat("book (", v, ", ", w, ", ", a, ", ", b, ") is flat (altitude ", fl, " of its longest edge)"));
       continue;

@@ -33,9 +33,16 @@ struct StitchBall {
 // 1-Lipschitz minorant of Definition 32's rad). For a book the "RepBall" is
 // max(|xa|, |xb|) at the circle point x and the angle is the circle's
 // (Definition 34). Pass π/2 and +∞ to switch both checks off.
+// The default of StitchOptions::min_flatness (see StitchedTetFlatness).
+inline constexpr double kFlatStitchedTet = 1e-9;
+
 struct StitchOptions {
   double max_rep_angle = std::numbers::pi / 6;
   double max_rep_ratio = 0.3;
+  // A positively oriented star or book whose StitchedTetFlatness is below
+  // this is refused as star_flat / book_flat. Tests raise it to make the
+  // refusal fire in scenes too small to hold a flat star.
+  double min_flatness = kFlatStitchedTet;
 };
 
 struct StitchInput {
@@ -63,11 +70,11 @@ struct StitchFailure {
     kLargeAngle,             // representation angle > options.max_rep_angle
     kCoarseSample,           // RepBall > options.max_rep_ratio · css(x)
     kStarInverted,           // Orient3d(star) ≤ 0
-    kStarFlat,               // Orient3d(star) > 0 but StitchedTetFlatness < kFlatStitchedTet
+    kStarFlat,               // Orient3d(star) > 0 but StitchedTetFlatness < options.min_flatness
     kNonManifoldEdge,        // an edge of T′ in ≠ 2 faces of T′
     kCircleCrossing,         // T′ edge vs circle disagreement (0/2 crossings, wrong pair)
     kBookDegenerate,         // Orient3d(book) = 0
-    kBookFlat,               // Orient3d(book) ≠ 0 but StitchedTetFlatness < kFlatStitchedTet
+    kBookFlat,               // Orient3d(book) ≠ 0 but StitchedTetFlatness < options.min_flatness
     kFaceMismatch,           // exact face matching failed (a face not shared properly)
     kVertexOutsideCollars,   // a vertex only on inside tets is not strictly inside a ball
     kCreaseVertexUnused,     // a crease vertex in no stitched tet
@@ -117,13 +124,12 @@ std::vector<uint32_t> PruneHiddenChainBalls(std::span<const CollarBall> balls, s
 // A stitched tet's smallest altitude over its longest edge (0 for a flat
 // tet, √(2/3) for a regular one). A star or book whose four vertices lie on
 // one plane up to rounding can still have Orient3d > 0; the stitch refuses
-// it below kFlatStitchedTet (star_flat / book_flat, repaired as an inverted
+// it below StitchOptions::min_flatness (star_flat / book_flat, repaired as an inverted
 // star / a degenerate book). Such a star lay on a facet through its ball's centre on
 // armadillo.off (session 34): its four faces were all on the facet within the
 // checker's tolerance, so the facet was counted twice over the tet's area
 // ("facet_not_covered ... cover area 1.2132, facet area 1.0988").
 double StitchedTetFlatness(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
-inline constexpr double kFlatStitchedTet = 1e-9;
 
 // Rip and stitch (see docs/svrc-collars.md "RipStitchCollar (stage f)"):
 //  1. A finite tet of dt is inside iff its circumcentre is strictly inside the

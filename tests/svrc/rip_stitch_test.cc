@@ -555,3 +555,73 @@ TEST(RipStitchTest, FlatStarFromArmadilloMeasuresFlat) {
 
 }  // namespace
 }  // namespace svrc::refine
+
+namespace svrc::refine {
+namespace {
+
+// StitchOptions::min_flatness is what refuses a flat star or book (the
+// armadillo.off star above). The scenes here hold no flat star, so the
+// threshold is raised to just above the least flat stitched tets: exactly
+// those are refused, stars as star_flat on S at their ball, books as
+// book_flat; at the least flatness itself the stitch passes with the same
+// tets. Removing either check, or testing the wrong tet, fails this.
+TEST(RipStitchTest, StarsAndBooksBelowMinFlatnessAreRefused) {
+  Scene s;
+  ChainScene(&s);
+  BuildScene(&s, 0.2, 4);
+  const absl::StatusOr<StitchResult> r0 = RipStitchCollar(InputOf(s));
+  ASSERT_TRUE(r0.ok()) << r0.status();
+  ASSERT_GT(r0->stars, 0u);
+  ASSERT_GT(r0->books, 0u);
+  auto P = [&s](uint32_t v) { return s.dt.Point(VertexId(v)); };
+  // (flatness, is_book) of every stitched tet.
+  std::vector<std::pair<double, bool>> fl;
+  for (size_t t = r0->outside_tets; t < r0->tets.size(); ++t) {
+    const auto& q = r0->tets[t];
+    fl.emplace_back(StitchedTetFlatness(P(q[0]), P(q[1]), P(q[2]), P(q[3])), t >= size_t{r0->outside_tets} + r0->stars);
+  }
+  std::sort(fl.begin(), fl.end());
+  ASSERT_GT(fl.front().first, kFlatStitchedTet);
+  for (const bool want_book : {false, true}) {
+    // A threshold between two well separated flatness values at or above
+    // the least flat star (book): the tets below it are the refused ones.
+    size_t k = 0;
+    while (fl[k].second != want_book) ++k;
+    while (k + 1 < fl.size() && !(fl[k + 1].first > fl[k].first * (1 + 1e-6))) ++k;
+    ASSERT_LT(k + 1, fl.size());
+    const double threshold = 0.5 * (fl[k].first + fl[k + 1].first);
+    size_t flat_stars = 0, flat_books = 0;
+    for (size_t i = 0; i <= k; ++i) ++(fl[i].second ? flat_books : flat_stars);
+    StitchInput in = InputOf(s);
+    in.options.min_flatness = threshold;
+    std::vector<StitchFailure> fails;
+    const absl::StatusOr<StitchResult> r = RipStitchCollar(in, &fails);
+    ASSERT_FALSE(r.ok()) << "threshold " << threshold;
+    EXPECT_EQ(r.status().code(), absl::StatusCode::kFailedPrecondition);
+    size_t got_stars = 0, got_books = 0;
+    for (const StitchFailure& f : fails) {
+      if (f.kind == StitchFailure::Kind::kStarFlat) {
+        ++got_stars;
+        ASSERT_LT(f.ball, s.balls.size());
+        EXPECT_NEAR(geom::Dist(f.where, s.balls[f.ball].center), s.balls[f.ball].radius, 1e-9) << f.detail;
+      } else if (f.kind == StitchFailure::Kind::kBookFlat) {
+        ++got_books;
+        ASSERT_LT(f.ball, s.balls.size());
+      }
+    }
+    EXPECT_EQ(got_stars, flat_stars) << (want_book ? "books" : "stars") << " threshold " << threshold << "\n"
+                                     << Describe(fails);
+    EXPECT_EQ(got_books, flat_books) << (want_book ? "books" : "stars") << " threshold " << threshold << "\n"
+                                     << Describe(fails);
+    EXPECT_GT(want_book ? got_books : got_stars, 0u);
+  }
+  // At the least flatness itself (not below it) nothing is refused.
+  StitchInput in = InputOf(s);
+  in.options.min_flatness = fl.front().first * (1 - 1e-6);
+  const absl::StatusOr<StitchResult> r = RipStitchCollar(in);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->tets, r0->tets);
+}
+
+}  // namespace
+}  // namespace svrc::refine
