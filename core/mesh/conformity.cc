@@ -478,7 +478,26 @@ class Checker {
     }
   }
 
+  // The first vertex of q within `tol` of its opposite face's plane (the
+  // on-plane rule of facets, docs/conformity.md), or -1. A positively
+  // oriented tet with such a vertex is flat at the checker's resolution: all
+  // its faces can lie on one facet, which then counts twice over the tet
+  // (armadillo.off's flat star, session 34), and its shape is meaningless.
+  int FlatVertex(const std::array<uint32_t, 4>& q, double tol) const {
+    static constexpr int kOpp[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    for (int k = 0; k < 4; ++k) {
+      const Vec3& a = P(q[kOpp[k][0]]);
+      const Vec3 n = Cross(P(q[kOpp[k][1]]) - a, P(q[kOpp[k][2]]) - a);
+      const double len = std::sqrt(Dot(n, n));
+      if (!(len > 0) || std::fabs(Dot(n, P(q[k]) - a)) <= tol * len) return k;
+    }
+    return -1;
+  }
+
   void CheckTets() {
+    // The on-plane tolerance from the mesh's own coordinates (the PLC's are
+    // not known to CheckValidity; the mesh holds them).
+    const double flat_tol = OnFeatureTolerance(mesh_.positions, opt_.tolerance_ulps);
     // (sorted vertex ids packed in two words, tet): integer comparisons only.
     std::vector<std::tuple<uint64_t, uint64_t, uint32_t>> sorted;
     sorted.reserve(mesh_.tets.size());
@@ -493,6 +512,10 @@ class Checker {
       } else if (s == 0) {
         Add(rep_, opt_, ViolationKind::kDegenerateTet, {static_cast<int64_t>(t)},
             absl::StrCat("tet ", t, " (", q[0], " ", q[1], " ", q[2], " ", q[3], ") is flat"));
+      } else if (const int k = FlatVertex(q, flat_tol); k >= 0) {
+        Add(rep_, opt_, ViolationKind::kFlatTet, {static_cast<int64_t>(t), q[k]},
+            absl::StrCat("tet ", t, " (", q[0], " ", q[1], " ", q[2], " ", q[3], ") is flat within the tolerance ",
+                         flat_tol, ": vertex ", q[k], " is on the plane of its opposite face"));
       }
       auto key = q;
       std::sort(key.begin(), key.end());
@@ -1943,6 +1966,7 @@ std::string_view KindName(ViolationKind kind) {
     case ViolationKind::kIdOutOfRange: return "id_out_of_range";
     case ViolationKind::kFlippedTet: return "flipped_tet";
     case ViolationKind::kDegenerateTet: return "degenerate_tet";
+    case ViolationKind::kFlatTet: return "flat_tet";
     case ViolationKind::kDuplicateTet: return "duplicate_tet";
     case ViolationKind::kFaceInMoreThanTwoTets: return "face_in_more_than_two_tets";
     case ViolationKind::kNeighborsSameSide: return "neighbors_same_side";

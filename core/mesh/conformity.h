@@ -24,6 +24,8 @@ enum class ViolationKind {
   kIdOutOfRange,          // ids: tet or triangle index, bad vertex id
   kFlippedTet,            // ids: tet (exact Orient3d < 0)
   kDegenerateTet,         // ids: tet (exact Orient3d == 0)
+  kFlatTet,               // ids: tet, vertex (Orient3d > 0, but the vertex is within the
+                          // on-plane tolerance of its opposite face's plane)
   kDuplicateTet,          // ids: tet, tet (same four vertices)
   kFaceInMoreThanTwoTets, // ids: the three face vertices, then the tets
   kNeighborsSameSide,     // ids: tet, tet sharing a face on the same side of it

@@ -468,6 +468,44 @@ TEST(Conformity, RejectsWrongMarkerDuplicatesAndBadIds) {
   }
 }
 
+// A positively oriented tet whose vertex lies within the on-plane
+// tolerance of its opposite face is flat_tet. The input that showed the
+// need: the star armadillo.off's stitch produced (session 34), Orient3d +1
+// by rounding; its four faces all lay on one facet, which the facet count
+// then covered twice over the tet, and fandisk.off's output held a tet of
+// radius-edge 6.85e13 that the checker passed.
+TEST(Conformity, RejectsTetsFlatWithinTheTolerance) {
+  TetMesh m;
+  m.positions = {Vec3(-5.6970999999999998, -0.020401800000000001, 40.214799999999997),
+                 Vec3(-5.7364019911771518, -0.27833771839876031, 40.519769688800025),
+                 Vec3(-5.8058945718646475, -0.53122204016648034, 40.388316931337513),
+                 Vec3(-5.7935405589433611, -0.3998141619699821, 40.12632642330879)};
+  m.tets = {{0, 1, 2, 3}};
+  ASSERT_GT(geom::Orient3d(m.positions[0], m.positions[1], m.positions[2], m.positions[3]), 0);
+  m.tet_region.assign(1, 0);
+  m.regions.resize(1);
+  ConformityReport r = CheckValidity(m);
+  EXPECT_EQ(r.Count(ViolationKind::kFlatTet), 1u) << r.Summary();
+  EXPECT_EQ(r.Count(ViolationKind::kDegenerateTet), 0u);
+  ASSERT_EQ(r.violations.size(), 1u);
+  EXPECT_EQ(r.violations[0].ids[0], 0);
+  // Unit scale: the tolerance is 8 ulps of 1. An apex 4 ulps above the base
+  // is flat; 1e-12 above it (a thin but real sliver) is not.
+  m.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.3, 0.3, 4 * 0x1p-52)};
+  ASSERT_GT(geom::Orient3d(m.positions[0], m.positions[1], m.positions[2], m.positions[3]), 0);
+  r = CheckValidity(m);
+  EXPECT_EQ(r.Count(ViolationKind::kFlatTet), 1u) << r.Summary();
+  ASSERT_EQ(r.violations.size(), 1u);
+  EXPECT_EQ(r.violations[0].ids[1], 3);
+  m.positions[3].z = 1e-12;
+  r = CheckValidity(m);
+  EXPECT_TRUE(r.ok()) << r.Summary();
+  // Looser tolerance_ulps makes the sliver flat too.
+  ConformityOptions loose;
+  loose.tolerance_ulps = 1e5;
+  EXPECT_EQ(CheckValidity(m, loose).Count(ViolationKind::kFlatTet), 1u);
+}
+
 TEST(Conformity, RejectsSameSideNeighbours) {
   // Two tets on the same side of their shared face: a positive tet and a
   // smaller positive tet inside it sharing the face.
