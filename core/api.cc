@@ -472,9 +472,10 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
       return st;
     }
     // max_volume inside the collars: the stitched stars and books are not
-    // refined by size events (the points inside are removed), so a collar
-    // larger than the bound leaves tets above it; refuse rather than return
-    // them.
+    // refined by size events (the points inside are removed); the size
+    // passes after the stitch put points of S into those above the bound
+    // (Refiner::QueueOversizedStitchRepairs, since session 35). Whatever
+    // they leave above it is refused, not returned.
     for (size_t t = 0; t < mesh.tets.size(); ++t) {
       const auto& v = mesh.tets[t];
       const geom::Vec3 a = mesh.positions[v[0]];
@@ -486,7 +487,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
       if (vol > bound * (1 + 1e-9)) {
         return absl::FailedPreconditionError(absl::StrCat(
             crease_head, "a tet of volume ", vol,
-            " next to the creases exceeds max_volume ", bound, " (collar tets are not refined by size yet)"));
+            " next to the creases exceeds max_volume ", bound, " after the size passes next to the collars"));
       }
     }
   }

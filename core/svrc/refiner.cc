@@ -398,6 +398,10 @@ class Refiner {
   // After a failed stitch: the representation points of T′ faces whose star
   // is inverted go in as COLLAR repairs (CD (3,2)); returns how many.
   absl::StatusOr<uint32_t> RepairStitchFailures();
+  // Stars and books of the stitched mesh above their region's volume bound
+  // (normalised): a point of S for each, into stitch_failures_.
+  void QueueOversizedStitchRepairs(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets,
+                                   const Labelling& lab, std::span<const double> comp_volume);
   // Consecutive collared points along each crease segment's M_s, in order:
   // (segment, vertex u of M_s, the next collared vertex w, their balls).
   struct CreaseBallPair {
@@ -3364,6 +3368,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       }
     }
   }
+  if (stitched_done_) QueueOversizedStitchRepairs(positions, tets, *lab, comp_volume);
   if (relabel) {
     // The slots of dead and ghost tets hold no label (a stale one would pass
     // PropagateSizeTargets' generation test as its cavity's).
@@ -3406,6 +3411,108 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     }
   }
   return any;
+}
+
+void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
+                                          std::span<const std::array<uint32_t, 4>> tets, const Labelling& lab,
+                                          std::span<const double> comp_volume) {
+  // max_volume inside the collars. The stars and books are not refined by
+  // size events: M_Ω's cells there still hold the points the stitch
+  // removes, so the size rounds see small cells while a star (c, face) has
+  // volume ρ·area(face)/3 and a book (v, w, a, b) grows with |ab|. Measured
+  // before this (session 35): crease_pair_30deg and knife_edge.poly with
+  // --max-volume 1e-5 were refused ("a tet of volume 1.05e-05 next to the
+  // creases exceeds max_volume 1e-05"). An oversized star gets the point of
+  // its ball's sphere over its face's centroid, a book the point of its
+  // circle nearest its T′ edge's midpoint: the face or edge is then split
+  // on S, as a COLLAR repair would (RepairStitchFailures inserts them).
+  stitch_failures_.clear();
+  std::vector<uint32_t> ball_of_vertex(positions.size(), CollarIndex::kNone);
+  for (uint32_t i = 0; i < collars_.size(); ++i) {
+    const uint32_t v = points_.VertexIn(collar_centre_[i], kOmegaMesh);
+    if (v != PointStore::kNoVertex && v < ball_of_vertex.size()) ball_of_vertex[v] = i;
+  }
+  for (size_t t = stitch_report_.outside_tets; t < tets.size(); ++t) {
+    const uint32_t c = lab.tet_component[t];
+    if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) continue;
+    const auto& q = tets[t];
+    const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
+    const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
+    if (!(vol > comp_volume[c] * (1 - 1e-9))) continue;
+    std::array<uint32_t, 2> centres{}, others{};
+    int nc = 0, no = 0;
+    for (uint32_t v : q) {
+      const uint32_t ball = ball_of_vertex[v];
+      if (ball != CollarIndex::kNone && nc < 2) {
+        centres[nc++] = ball;
+      } else if (no < 2) {
+        others[no++] = v;
+      }
+    }
+    // FindContaining names the lowest ball with x strictly inside; a point
+    // constructed on a sphere or circle can be inside its own ball(s) by
+    // rounding, which does not take it off S.
+    auto on_s = [&](const Vec3& x, uint32_t i, uint32_t j) {
+      const uint32_t o = collars_.FindContaining(x);
+      return o == CollarIndex::kNone || o == i || o == j;
+    };
+    auto circle_point = [&](uint32_t i, uint32_t j, const Vec3& near, Vec3* x) {
+      Circle3 circle;
+      if (!SphereSphereCircle(collars_.ball(i), collars_.ball(j), &circle)) return false;
+      const Vec3 dm = near - circle.center;
+      const Vec3 in_plane = dm - geom::Dot(dm, circle.normal) * circle.normal;
+      const double len = geom::Norm(in_plane);
+      if (!(len > 0)) return false;
+      *x = circle.center + (circle.radius / len) * in_plane;
+      return on_s(*x, i, j);
+    };
+    if (nc == 1) {
+      // A star: its face's centroid projected from the ball's centre; when
+      // that lies in a neighbouring ball, the face is at their circle: its
+      // point nearest the centroid.
+      const uint32_t i = centres[0];
+      const CollarBall& ball = collars_.ball(i);
+      Vec3 g(0, 0, 0);
+      for (uint32_t v : q) {
+        if (ball_of_vertex[v] != i) g = g + positions[v] / 3.0;
+      }
+      const Vec3 dir = g - ball.center;
+      const double len = geom::Norm(dir);
+      if (!(len > 0)) continue;
+      Vec3 x = ball.center + (ball.radius / len) * dir;
+      if (on_s(x, i, i)) {
+        stitch_failures_.push_back({x, i, 2});
+        continue;
+      }
+      const uint32_t k = collars_.FindContaining(x);
+      if (circle_point(i, k, g, &x)) {
+        stitch_failures_.push_back({x, i, 1});
+      }
+    } else if (nc == 2 && no == 2) {
+      // A book: the crease circle's point nearest its T′ edge's midpoint.
+      Vec3 x;
+      if (circle_point(centres[0], centres[1], 0.5 * (positions[others[0]] + positions[others[1]]), &x)) {
+        stitch_failures_.push_back({x, centres[0], 1});
+      }
+    }
+  }
+  stats_.stitch_size_repairs += stitch_failures_.size();
+  if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
+    size_t over = 0, over_out = 0;
+    for (size_t t = 0; t < tets.size(); ++t) {
+      const uint32_t c = lab.tet_component[t];
+      if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) continue;
+      const auto& q = tets[t];
+      const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
+      const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
+      if (vol > comp_volume[c] * (1 - 1e-9)) {
+        ++over;
+        if (t < stitch_report_.outside_tets) ++over_out;
+      }
+    }
+    std::fprintf(stderr, "size pass: %zu stitched tets over (%zu outside), %zu repairs queued\n", over, over_out,
+                 stitch_failures_.size());
+  }
 }
 
 absl::StatusOr<bool> Refiner::BreakSlivers(double min_deg, bool first) {
@@ -3951,6 +4058,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.points_12_without_ball", static_cast<double>(points_12_without_ball));
   out->Set("svrc.stitch_hidden_balls", static_cast<double>(stitch_hidden_balls));
   out->Set("svrc.stitch_flat_tets", static_cast<double>(stitch_flat_tets));
+  out->Set("svrc.stitch_size_repairs", static_cast<double>(stitch_size_repairs));
   out->Set("svrc.neck_splits", static_cast<double>(neck_splits));
   out->Set("svrc.collar_rounds", static_cast<double>(collar_rounds));
   if (collars > 0) {
@@ -4263,7 +4371,11 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   // carry over); 64 passes at most.
   absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
   if (!more.ok()) return more.status();
-  if (!*more) break;
+  // Stars and books above the bound (QueueOversizedStitchRepairs): points
+  // on S.
+  absl::StatusOr<uint32_t> size_repairs = refiner.RepairStitchFailures();
+  if (!size_repairs.ok()) return size_repairs.status();
+  if (!*more && *size_repairs == 0) break;
   if (++size_passes == 64) {
     return absl::ResourceExhaustedError("SVRC: max_volume next to the collars did not settle in 64 passes");
   }
