@@ -152,7 +152,12 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
     geom::Box3 box;
     for (const plc::FeaturePoint& p : complex.points) box.Add(p.p);
     const geom::Vec3 e = box.hi - box.lo;
-    const double boxes = e.x * e.y * e.z / vmax;
+    // keep_bounding_box meshes all of Ω, a cube of side 3·diam (Definition
+    // 35, refine::NormaliseInput): tetra.poly --keep-bounding-box
+    // --max-volume 1e-4 ran out of the input box's budget (100,016
+    // vertices), blamed on its 70.5° crease (session 35).
+    const double side = 3 * box.Diagonal();
+    const double boxes = (params.keep_bounding_box ? side * side * side : e.x * e.y * e.z) / vmax;
     // Capped: a budget past 2^40 vertices is no budget; memory ends it first.
     budget += static_cast<uint64_t>(std::min(boxes, 1e12));
   }

@@ -20,6 +20,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/mesh/conformity.h"
 #include "core/mesh/stats_payload.h"
+#include "core/geometry/constructions.h"
 #include "core/geometry/predicates.h"
 #include "core/plc/features.h"
 #include "core/plc/intersect.h"
@@ -398,8 +399,12 @@ class Refiner {
   // After a failed stitch: the representation points of T′ faces whose star
   // is inverted go in as COLLAR repairs (CD (3,2)); returns how many.
   absl::StatusOr<uint32_t> RepairStitchFailures();
+  // Inserts size_points_ (CollectOversizedDelaunayTets); returns how many.
+  absl::StatusOr<uint32_t> InsertSizePoints();
   // Stars and books of the stitched mesh above their region's volume bound
   // (normalised): a point of S for each, into stitch_failures_.
+  void CollectOversizedDelaunayTets(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets,
+                                   size_t count, const Labelling& lab, std::span<const double> comp_volume);
   void QueueOversizedStitchRepairs(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets,
                                    const Labelling& lab, std::span<const double> comp_volume);
   // Consecutive collared points along each crease segment's M_s, in order:
@@ -681,6 +686,10 @@ class Refiner {
     uint8_t collar_dim = 2;
   };
   std::vector<StitchRepair> stitch_failures_;
+  // Points of Ω for kept Delaunay tets above their volume bound
+  // (CollectOversizedDelaunayTets): the circumcentre, clamped to Ω, and
+  // the tet's circumradius.
+  std::vector<std::pair<Vec3, double>> size_points_;
   std::vector<uint8_t> neck_point_;             // per point: SplitCollarNecks' points get a ball even inside a collar
   std::vector<uint8_t> suppressed_;             // per point: 1 once strictly inside a collar
   std::vector<std::vector<uint32_t>> point_segments_;  // per complex point: segments ending there
@@ -1561,7 +1570,22 @@ absl::Status Refiner::DestroyOmega(VertexId v, bool skinny) {
   return DestroyOmegaAt(s.corner, s.outradius, s.hint, v);
 }
 
-absl::Status Refiner::DestroyOmegaAt(const Vec3& c, double r, TetId cell_hint, VertexId v, Cd cd_ball) {
+absl::Status Refiner::DestroyOmegaAt(const Vec3& c_in, double r, TetId cell_hint, VertexId v, Cd cd_ball) {
+  // A centre within a few ulps of a face of Ω goes onto it. A circumcentre
+  // of a tet on ∂Ω can be rounded just inside (clipped corners are on it
+  // exactly): the point then makes a tet with three points of that face,
+  // positive by rounding and flat, which keep_bounding_box returns
+  // (segment_fan.poly --keep-bounding-box, session 35: a point 1 ulp below
+  // the top face, refused by the checker's flat_tet).
+  Vec3 c = c_in;
+  {
+    const geom::Box3& box = omega_.cube();
+    for (int k = 0; k < 3; ++k) {
+      const double tol = 8 * 0x1p-52 * std::max(std::fabs(box.lo[k]), std::fabs(box.hi[k]));
+      if (std::fabs(c[k] - box.lo[k]) <= tol) c[k] = box.lo[k];
+      if (std::fabs(c[k] - box.hi[k]) <= tol) c[k] = box.hi[k];
+    }
+  }
   struct {
     TetId hint;
   } s{cell_hint};
@@ -2527,6 +2551,24 @@ void Refiner::DebugNonSmoothPairs() const {
   }
 }
 
+absl::StatusOr<uint32_t> Refiner::InsertSizePoints() {
+  const delaunay::Delaunay3& dt = omega_.dt();
+  uint32_t inserted = 0;
+  stats_.clipped_size_points += size_points_.size();
+  for (const auto& [x, radius] : size_points_) {
+    const VertexId v = dt.NearestVertex(x);
+    const double r = geom::Dist(dt.Point(v), x);
+    // An earlier point of this list may have been put next to it.
+    if (!(r > 1e-3 * radius)) continue;
+    absl::Status st = DestroyOmegaAt(x, r, dt.VertexTet(v), v);
+    if (!st.ok()) return st;
+    ++inserted;
+  }
+  size_points_.clear();
+  if (inserted > 0) ClearStitch();
+  return inserted;
+}
+
 absl::StatusOr<uint32_t> Refiner::RepairStitchFailures() {
   // A T′ face whose star over its ball's centre is inverted lies nearly
   // edge-on to the centre; its Voronoi edge's root x on S is the centre of
@@ -3368,6 +3410,8 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
       }
     }
   }
+  CollectOversizedDelaunayTets(positions, tets, stitched_done_ ? stitch_report_.outside_tets : tets.size(), *lab,
+                               comp_volume);
   if (stitched_done_) QueueOversizedStitchRepairs(positions, tets, *lab, comp_volume);
   if (relabel) {
     // The slots of dead and ghost tets hold no label (a stale one would pass
@@ -3411,6 +3455,40 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     }
   }
   return any;
+}
+
+void Refiner::CollectOversizedDelaunayTets(std::span<const Vec3> positions,
+                                           std::span<const std::array<uint32_t, 4>> tets, size_t count,
+                                           const Labelling& lab, std::span<const double> comp_volume) {
+  // M_Ω's kept tets (the first `count` of `tets`) above their volume bound.
+  // The cell test sizes a cell clipped by ∂Ω by its corners in Ω, so the
+  // cell can look small while a tet at ∂Ω, its circumcentre outside Ω, is
+  // above the bound. keep_bounding_box keeps those tets (as does a PLC
+  // without facets): cube.poly --keep-bounding-box --max-volume 1e-2 had a
+  // tet of 0.0130, tetra.poly 0.0113, and on the collar path crease_pair_30
+  // with 1e-4 was refused for 13 tets above it (session 35). Such a tet
+  // gets its circumcentre, or the nearest point of Ω to it; InsertSizePoints
+  // inserts them once the cell test finds nothing more.
+  size_points_.clear();
+  const geom::Box3& cube = omega_.cube();
+  for (size_t t = 0; t < count && t < tets.size(); ++t) {
+    const uint32_t c = lab.tet_component[t];
+    if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) continue;
+    const auto& q = tets[t];
+    const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
+    const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
+    if (!(vol > comp_volume[c] * (1 - 1e-9))) continue;
+    const Vec3 o = geom::TetCircumcenter(a, b, cc, d);
+    Vec3 x = o;
+    for (int k = 0; k < 3; ++k) x[k] = std::clamp(x[k], cube.lo[k], cube.hi[k]);
+    size_points_.emplace_back(x, geom::Dist(o, a));
+  }
+  std::sort(size_points_.begin(), size_points_.end(), [](const auto& l, const auto& r) {
+    return std::tie(l.first.x, l.first.y, l.first.z) < std::tie(r.first.x, r.first.y, r.first.z);
+  });
+  size_points_.erase(std::unique(size_points_.begin(), size_points_.end(),
+                                 [](const auto& l, const auto& r) { return l.first == r.first; }),
+                     size_points_.end());
 }
 
 void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
@@ -3497,6 +3575,7 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
     }
   }
   stats_.stitch_size_repairs += stitch_failures_.size();
+
   if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
     size_t over = 0, over_out = 0;
     for (size_t t = 0; t < tets.size(); ++t) {
@@ -4059,6 +4138,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.stitch_hidden_balls", static_cast<double>(stitch_hidden_balls));
   out->Set("svrc.stitch_flat_tets", static_cast<double>(stitch_flat_tets));
   out->Set("svrc.stitch_size_repairs", static_cast<double>(stitch_size_repairs));
+  out->Set("svrc.clipped_size_points", static_cast<double>(clipped_size_points));
   out->Set("svrc.neck_splits", static_cast<double>(neck_splits));
   out->Set("svrc.collar_rounds", static_cast<double>(collar_rounds));
   if (collars > 0) {
@@ -4263,7 +4343,12 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   for (int round = 0; any_volume && !sizes_after_stitch && round < 64; ++round) {
     absl::StatusOr<bool> more = refiner.SetSizeTargets(complex, options.max_volume);
     if (!more.ok()) return more.status();
-    if (!*more) break;
+    if (!*more) {
+      // What the cell test missed (CollectOversizedDelaunayTets).
+      absl::StatusOr<uint32_t> size_points = refiner.InsertSizePoints();
+      if (!size_points.ok()) return size_points.status();
+      if (*size_points == 0) break;
+    }
     refiner.CountSizeRound();
     s = refiner.Run();
     if (!s.ok()) return s;
@@ -4375,7 +4460,13 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   // on S.
   absl::StatusOr<uint32_t> size_repairs = refiner.RepairStitchFailures();
   if (!size_repairs.ok()) return size_repairs.status();
-  if (!*more && *size_repairs == 0) break;
+  // The kept Delaunay tets the cell test missed (clipped cells), once it
+  // finds nothing more: while it does, most tets above the bound are its
+  // own work (inserting every one's circumcentre as well ran crease_pair_30
+  // --keep-bounding-box --max-volume 1e-4 into the vertex budget).
+  absl::StatusOr<uint32_t> size_points = *more ? absl::StatusOr<uint32_t>(0) : refiner.InsertSizePoints();
+  if (!size_points.ok()) return size_points.status();
+  if (!*more && *size_repairs == 0 && *size_points == 0) break;
   if (++size_passes == 64) {
     return absl::ResourceExhaustedError("SVRC: max_volume next to the collars did not settle in 64 passes");
   }

@@ -435,6 +435,84 @@ TEST(CreaseMesh, KnifeEdgeKeepsTheBoundingBox) {
   EXPECT_GT(q.crease.num_tets, 0u);
 }
 
+// keep_bounding_box on the collar path, two failures found in session 35 by
+// running the crease inputs with option combinations:
+//  - segment_fan.poly: a centre rounded 1 ulp inside Ω's top face made a tet
+//    with three points of that face, positive and flat; the box keeps it,
+//    and the checker's flat_tet refused the mesh. Centres within 8 ulps of
+//    ∂Ω now go onto it (Refiner::DestroyOmegaAt).
+//  - crease_pair_30 with max_volume 1e-2 (1e-4 the same): 2 Delaunay tets
+//    next to ∂Ω above the bound after the size passes (their cells, clipped
+//    by Ω, looked small), refused ("a tet of volume ... exceeds max_volume").
+//    Once the cell test finds nothing, such a tet gets its circumcentre,
+//    clamped to Ω (svrc.clipped_size_points).
+// A crease of 45° or more (tetra.poly: 70.5°) is refined through without
+// collars under a vertex budget sized by the input's box and max_volume.
+// With keep_bounding_box the mesh is all of Ω (a cube of side 3·diam, ~140×
+// the box here): tetra.poly --keep-bounding-box --max-volume 1e-4 ended
+// FAILED_PRECONDITION "refinement without collars did not finish within
+// 100016 vertices" (session 35). The budget now uses Ω's volume.
+TEST(CreaseMesh, MildCreaseBudgetCoversOmegaWithKeepBoundingBox) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  absl::StatusOr<plc::Plc> tetra = plc::ReadPlcFile(testing::CorpusPath("a_convex/tetra.poly"));
+  ASSERT_TRUE(tetra.ok()) << tetra.status();
+  core::MeshParams params;
+  params.keep_bounding_box = true;
+  params.max_volume = 1e-2;
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(*tetra, params);
+  ASSERT_TRUE(m.ok()) << m.status();
+  mesh::ConformityOptions opt;
+  opt.keep_bounding_box = true;
+  const mesh::ConformityReport rep = mesh::CheckConformity(*tetra, *m, opt);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  double vmax = 0;
+  for (const auto& t : m->tets) {
+    const geom::Vec3 a = m->positions[t[0]];
+    vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
+  }
+  EXPECT_LE(vmax, 1e-2 * (1 + 1e-9));
+  // More vertices than the input box's budget (20,016 + 8 / 1e-2) allowed.
+  EXPECT_GT(m->positions.size(), 20016u + 800u);
+}
+
+TEST(CreaseMesh, KeepBoundingBoxHasNoFlatTetsAndMeetsMaxVolume) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  absl::StatusOr<plc::Plc> fan = plc::ReadPlcFile(testing::CorpusPath("d_small_angles/segment_fan.poly"));
+  ASSERT_TRUE(fan.ok()) << fan.status();
+  mesh::ConformityOptions opt;
+  opt.keep_bounding_box = true;
+  {
+    core::MeshParams params;
+    params.keep_bounding_box = true;
+    absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(*fan, params);
+    ASSERT_TRUE(m.ok()) << m.status();
+    const mesh::ConformityReport rep = mesh::CheckConformity(*fan, *m, opt);
+    EXPECT_TRUE(rep.ok()) << rep.Summary();
+    EXPECT_GT(m->stats.Get("svrc.collars"), 0);
+  }
+  const plc::Plc pair = plc::families::CreaseFacetPair(30);
+  core::MeshParams params;
+  params.keep_bounding_box = true;
+  params.max_volume = 1e-2;
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(pair, params);
+  ASSERT_TRUE(m.ok()) << m.status();
+  const mesh::ConformityReport rep = mesh::CheckConformity(pair, *m, opt);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  double vmax = 0;
+  for (const auto& t : m->tets) {
+    const geom::Vec3 a = m->positions[t[0]];
+    vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
+  }
+  EXPECT_LE(vmax, 1e-2 * (1 + 1e-9));
+  EXPECT_GT(m->stats.Get("svrc.clipped_size_points"), 0) << "the cell test alone met the bound";
+  std::printf("crease_pair_30 --keep-bounding-box --max-volume 1e-2: %zu tets, max volume %.4g, %g size points\n",
+              m->tets.size(), vmax, m->stats.Get("svrc.clipped_size_points"));
+}
+
 TEST(CreaseMesh, CorpusInputsThatMesh) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";

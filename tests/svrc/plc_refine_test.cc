@@ -169,6 +169,28 @@ TEST(PlcRefine, MaxVolumeGlobalAndPerRegion) {
   }
 }
 
+// keep_bounding_box with max_volume: every tet of Ω within the bound. The
+// cell test sizes a cell clipped by ∂Ω by its corners inside Ω, so a tet at
+// ∂Ω whose circumcentre is outside Ω could stay above the bound: until
+// session 35 cube.poly --keep-bounding-box --max-volume 1e-2 returned a tet
+// of volume 0.0130. Such tets now get their circumcentre clamped to Ω once
+// the cell test finds nothing (svrc.clipped_size_points).
+TEST(PlcRefine, KeepBoundingBoxMeetsMaxVolume) {
+  core::MeshParams params;
+  params.keep_bounding_box = true;
+  params.max_volume = 1e-2;
+  Meshed m = MeshCorpus("a_convex/cube.poly", params);
+  ASSERT_FALSE(m.mesh.tets.empty());
+  mesh::ConformityOptions opt;
+  opt.keep_bounding_box = true;
+  const mesh::ConformityReport rep = mesh::CheckConformity(m.plc, m.mesh, opt);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  double worst = 0;
+  for (size_t t = 0; t < m.mesh.tets.size(); ++t) worst = std::max(worst, Volume6(m.mesh, t) / 6);
+  EXPECT_LE(worst, 1e-2 * (1 + 1e-9));
+  EXPECT_GT(m.mesh.stats.Get("svrc.clipped_size_points"), 0) << "the cell test alone met the bound";
+}
+
 // Same input and parameters, same output bytes (the container encodes every
 // array; the provenance has no time stamp).
 TEST(PlcRefine, Deterministic) {
