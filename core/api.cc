@@ -152,12 +152,10 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
     geom::Box3 box;
     for (const plc::FeaturePoint& p : complex.points) box.Add(p.p);
     const geom::Vec3 e = box.hi - box.lo;
-    // keep_bounding_box meshes all of Ω, a cube of side 3·diam (Definition
-    // 35, refine::NormaliseInput): tetra.poly --keep-bounding-box
-    // --max-volume 1e-4 ran out of the input box's budget (100,016
-    // vertices), blamed on its 70.5° crease (session 35).
-    const double side = 3 * box.Diagonal();
-    const double boxes = (params.keep_bounding_box ? side * side * side : e.x * e.y * e.z) / vmax;
+    // With keep_bounding_box the complex holds Ω's cube as facets, so this
+    // is Ω's volume (tetra.poly --keep-bounding-box --max-volume 1e-4 ran
+    // out of the input box's budget, 100,016 vertices, before session 35).
+    const double boxes = e.x * e.y * e.z / vmax;
     // Capped: a budget past 2^40 vertices is no budget; memory ends it first.
     budget += static_cast<uint64_t>(std::min(boxes, 1e12));
   }
@@ -276,7 +274,72 @@ void DiagnoseUnsealed(const plc::Plc& plc, const refine::PointSetRefinement& ref
 
 // A PLC with segments or facets: SVRC refinement (core/svrc, thesis ch. 3),
 // then region labelling and assembly (docs/svrc-output.md).
-absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams& params,
+// The input's box, as refine::NormaliseInput makes Ω: the cube of side
+// 3·diam centred on the bounding box of the vertices (a unit cube for a
+// single point).
+geom::Box3 OmegaCubeOf(const plc::Plc& plc) {
+  geom::Box3 box;
+  for (const geom::Vec3& p : plc.vertices) box.Add(p);
+  const double diam = box.Diagonal();
+  const double half = diam > 0 ? 1.5 * diam : 0.5;
+  const geom::Vec3 c = box.Center();
+  return geom::Box3{c - geom::Vec3{half, half, half}, c + geom::Vec3{half, half, half}};
+}
+
+// `plc` with Ω's cube as six more facets (8 more vertices, after the
+// input's) and no hole seeds.
+plc::Plc WithBoundingBoxFacets(const plc::Plc& plc) {
+  plc::Plc out = plc;
+  const geom::Box3 cube = OmegaCubeOf(plc);
+  const uint32_t n = static_cast<uint32_t>(out.vertices.size());
+  for (int i = 0; i < 8; ++i) {
+    out.vertices.push_back({(i & 1) ? cube.hi.x : cube.lo.x, (i & 2) ? cube.hi.y : cube.lo.y,
+                            (i & 4) ? cube.hi.z : cube.lo.z});
+  }
+  if (!out.vertex_markers.empty()) out.vertex_markers.resize(out.vertices.size(), 0);
+  if (!out.vertex_lines.empty()) out.vertex_lines.resize(out.vertices.size(), 0);
+  static constexpr uint32_t kQuads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                            {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : kQuads) {
+    plc::Facet f;
+    f.polygons.push_back(plc::Polygon{{n + q[0], n + q[1], n + q[2], n + q[3]}});
+    out.facets.push_back(std::move(f));
+  }
+  if (!out.facet_lines.empty()) out.facet_lines.resize(out.facets.size(), 0);
+  out.holes.clear();
+  return out;
+}
+
+// Removes the triangles on Ω's cube (WithBoundingBoxFacets) from the
+// output: they lie on no input facet. A triangle is on a face of the cube
+// when its three vertices have that face's coordinate within the on-feature
+// tolerance (axis-aligned facets keep it exactly).
+void DropBoxTriangles(const plc::Plc& user_plc, mesh::TetMesh* m) {
+  const geom::Box3 cube = OmegaCubeOf(user_plc);
+  const std::array<geom::Vec3, 2> corners = {cube.lo, cube.hi};
+  const double tol = mesh::OnFeatureTolerance(corners);
+  auto on_box = [&](const std::array<uint32_t, 3>& t) {
+    for (int k = 0; k < 3; ++k) {
+      for (double b : {cube.lo[k], cube.hi[k]}) {
+        if (std::all_of(t.begin(), t.end(), [&](uint32_t v) { return std::fabs(m->positions[v][k] - b) <= tol; })) {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  size_t w = 0;
+  for (size_t i = 0; i < m->triangles.size(); ++i) {
+    if (on_box(m->triangles[i])) continue;
+    m->triangles[w] = m->triangles[i];
+    if (i < m->triangle_marker.size()) m->triangle_marker[w] = m->triangle_marker[i];
+    ++w;
+  }
+  m->triangles.resize(w);
+  if (m->triangle_marker.size() > w) m->triangle_marker.resize(w);
+}
+
+absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshParams& params,
                                           const ProgressCallback& progress, const CancelToken* cancel) {
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
@@ -304,6 +367,18 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     return absl::UnimplementedError("min_dihedral: sliver removal is not implemented yet");
   }
   report("validate", 0, 0, 0);
+  // keep_bounding_box (and a PLC without facets, which encloses nothing):
+  // the output is all of Ω, the cube of side 3·diam around the input. Its six
+  // faces join the PLC as facets, so the box is meshed like any domain:
+  // radius-edge within the bound up to its faces, max_volume per tet. As
+  // scaffolding, Ω's tets next to ∂Ω were never refined for quality: cube.poly
+  // --keep-bounding-box had radius-edge 44 there, nested_boxes_3 with
+  // max_volume 3e-2 8.6e7 and dihedrals of 180° (session 35). The box's
+  // triangles are not input facets and leave the output's triangles; hole
+  // seeds are ignored, as they were (the whole Ω is returned).
+  const bool keep_box = params.keep_bounding_box || user_plc.facets.empty();
+  const plc::Plc boxed = keep_box ? WithBoundingBoxFacets(user_plc) : plc::Plc{};
+  const plc::Plc& plc = keep_box ? boxed : user_plc;
   plc::ValidationReport vreport;
   absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(plc, {}, {}, &vreport);
   if (!complex.ok()) {
@@ -315,9 +390,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   options.theta = params.theta;
   options.max_vertices = params.max_vertices;
   options.max_volume = params.max_volume;
-  // A PLC without facets encloses nothing: its output is the whole Ω mesh.
-  const bool keep_box = params.keep_bounding_box || complex->facets.empty();
-  options.keep_bounding_box = keep_box;
+  // With the box as facets nothing is outside the domain but what lies
+  // outside the box (refine's Ω is now larger than it).
+  options.keep_bounding_box = false;
   if (cancel != nullptr || progress) {
     options.poll = [&]() -> absl::Status {
       if (cancel != nullptr) {
@@ -422,7 +497,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
   const refine::CoordinateMap map = refine::CoordinateMapOf(*refined);
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex, faces, map,
-                              keep_box, &stats);
+                              /*keep_bounding_box=*/false, &stats);
   if (!out.ok()) {
     // The labelling says "no tetrahedron is left" (INVALID_ARGUMENT) for an
     // open surface or hole seeds that fill every region. Validation has
@@ -450,6 +525,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                             " tets inverted by mapping Steiner points back to input coordinates"));
   }
   mesh::TetMesh mesh = std::move(out->mesh);
+  if (keep_box) DropBoxTriangles(user_plc, &mesh);
   if (use_collars) {
     // The collar stage is new and its conformity next to the creases is
     // shown per input (docs/svrc-collars.md), not proven for every PLC:
@@ -461,7 +537,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
     // --keep-bounding-box: 66 "open faces" on knife_edge.poly).
     mesh::ConformityOptions check_options;
     check_options.keep_bounding_box = keep_box;
-    const mesh::ConformityReport check = mesh::CheckConformity(plc, mesh, check_options);
+    const mesh::ConformityReport check = mesh::CheckConformity(user_plc, mesh, check_options);
     if (!check.ok()) {
       // Debugging aid for the collar stage (docs/svrc-collars.md): the
       // refused mesh, written where SVRC_DUMP_NONCONFORMING points (any
@@ -504,7 +580,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& plc, const MeshParams&
                                                 : "",
                                             use_collars && !params.collar_tet_quality ? " collar_cell_test=1" : "",
                                             " keep_bounding_box=", params.keep_bounding_box ? 1 : 0);
-  mesh.provenance.input_sha256 = plc.input_sha256;
+  mesh.provenance.input_sha256 = user_plc.input_sha256;
   mesh.stats.Set("tets", static_cast<double>(mesh.tets.size()));
   mesh.stats.Set("output_vertices", static_cast<double>(mesh.positions.size()));
   mesh.stats.Set("seconds_validate", seconds_validate);

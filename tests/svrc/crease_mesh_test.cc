@@ -444,8 +444,9 @@ TEST(CreaseMesh, KnifeEdgeKeepsTheBoundingBox) {
 //  - crease_pair_30 with max_volume 1e-2 (1e-4 the same): 2 Delaunay tets
 //    next to ∂Ω above the bound after the size passes (their cells, clipped
 //    by Ω, looked small), refused ("a tet of volume ... exceeds max_volume").
-//    Once the cell test finds nothing, such a tet gets its circumcentre,
-//    clamped to Ω (svrc.clipped_size_points).
+//    Ω's cube is now six facets of the PLC (core/api.cc
+//    WithBoundingBoxFacets): its tets are tested like any domain's, and the
+//    radius-edge bound holds up to the box (it was 1217 on crease_pair_10).
 // A crease of 45° or more (tetra.poly: 70.5°) is refined through without
 // collars under a vertex budget sized by the input's box and max_volume.
 // With keep_bounding_box the mesh is all of Ω (a cube of side 3·diam, ~140×
@@ -508,9 +509,11 @@ TEST(CreaseMesh, KeepBoundingBoxHasNoFlatTetsAndMeetsMaxVolume) {
     vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
   }
   EXPECT_LE(vmax, 1e-2 * (1 + 1e-9));
-  EXPECT_GT(m->stats.Get("svrc.clipped_size_points"), 0) << "the cell test alone met the bound";
-  std::printf("crease_pair_30 --keep-bounding-box --max-volume 1e-2: %zu tets, max volume %.4g, %g size points\n",
-              m->tets.size(), vmax, m->stats.Get("svrc.clipped_size_points"));
+  const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(pair, *m));
+  EXPECT_GT(q.crease.num_tets, 0u);
+  EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9));
+  std::printf("crease_pair_30 --keep-bounding-box --max-volume 1e-2: %zu tets, max volume %.4g, radius-edge away "
+              "from creases %.4g\n", m->tets.size(), vmax, q.other.radius_edge.max);
 }
 
 TEST(CreaseMesh, CorpusInputsThatMesh) {

@@ -1,6 +1,7 @@
 // End-to-end SVRC on PLCs without creases (issue #5 "Must show"): corpus files
 // through core::MeshPlc, every output checked by the conformity checker of #3
 // (valid, covers, conforms) and for radius-edge ≤ the bound on every tet.
+#include <cmath>
 #include <string>
 
 #include "core/api.h"
@@ -169,26 +170,40 @@ TEST(PlcRefine, MaxVolumeGlobalAndPerRegion) {
   }
 }
 
-// keep_bounding_box with max_volume: every tet of Ω within the bound. The
-// cell test sizes a cell clipped by ∂Ω by its corners inside Ω, so a tet at
-// ∂Ω whose circumcentre is outside Ω could stay above the bound: until
-// session 35 cube.poly --keep-bounding-box --max-volume 1e-2 returned a tet
-// of volume 0.0130. Such tets now get their circumcentre clamped to Ω once
-// the cell test finds nothing (svrc.clipped_size_points).
-TEST(PlcRefine, KeepBoundingBoxMeetsMaxVolume) {
-  core::MeshParams params;
-  params.keep_bounding_box = true;
-  params.max_volume = 1e-2;
-  Meshed m = MeshCorpus("a_convex/cube.poly", params);
-  ASSERT_FALSE(m.mesh.tets.empty());
-  mesh::ConformityOptions opt;
-  opt.keep_bounding_box = true;
-  const mesh::ConformityReport rep = mesh::CheckConformity(m.plc, m.mesh, opt);
-  EXPECT_TRUE(rep.ok()) << rep.Summary();
-  double worst = 0;
-  for (size_t t = 0; t < m.mesh.tets.size(); ++t) worst = std::max(worst, Volume6(m.mesh, t) / 6);
-  EXPECT_LE(worst, 1e-2 * (1 + 1e-9));
-  EXPECT_GT(m.mesh.stats.Get("svrc.clipped_size_points"), 0) << "the cell test alone met the bound";
+// keep_bounding_box: the whole Ω is returned, and every tet of it meets the
+// radius-edge bound and max_volume. Until session 35 Ω's tets next to ∂Ω
+// were scaffolding, never refined for quality: cube.poly --keep-bounding-box
+// had radius-edge 44 there, and with --max-volume 1e-2 radius-edge 2841 and
+// a tet of volume 0.0130 (its cell, clipped by ∂Ω, looked small). Ω's cube
+// now joins the PLC as six facets (core/api.cc WithBoundingBoxFacets).
+TEST(PlcRefine, KeepBoundingBoxMeetsTheBoundsUpToTheBox) {
+  for (const double vmax_bound : {0.0, 1e-2}) {
+    core::MeshParams params;
+    params.keep_bounding_box = true;
+    params.max_volume = vmax_bound;
+    Meshed m = MeshCorpus("a_convex/cube.poly", params);
+    ASSERT_FALSE(m.mesh.tets.empty());
+    mesh::ConformityOptions opt;
+    opt.keep_bounding_box = true;
+    const mesh::ConformityReport rep = mesh::CheckConformity(m.plc, m.mesh, opt);
+    EXPECT_TRUE(rep.ok()) << rep.Summary();
+    // The box is Ω: side 3·diam = 3√3 around the unit cube.
+    EXPECT_NEAR(rep.mesh_volume, std::pow(3 * std::sqrt(3.0), 3), 1e-9 * rep.mesh_volume);
+    const mesh::QualityReport q = mesh::ComputeQuality(m.mesh, {});
+    EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9)) << "max_volume " << vmax_bound;
+    // Only the input's facets are boundary triangles (the cube's 6 faces).
+    for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+      for (uint32_t v : m.mesh.triangles[t]) {
+        const geom::Vec3& p = m.mesh.positions[v];
+        EXPECT_TRUE(p.x >= 0 && p.x <= 1 && p.y >= 0 && p.y <= 1 && p.z >= 0 && p.z <= 1) << "triangle " << t;
+      }
+    }
+    if (vmax_bound > 0) {
+      double worst = 0;
+      for (size_t t = 0; t < m.mesh.tets.size(); ++t) worst = std::max(worst, Volume6(m.mesh, t) / 6);
+      EXPECT_LE(worst, vmax_bound * (1 + 1e-9));
+    }
+  }
 }
 
 // Same input and parameters, same output bytes (the container encodes every
