@@ -3457,6 +3457,19 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   return any;
 }
 
+// Tet t is in a kept component with a volume bound and its volume is
+// above it (normalised coordinates; 1e-9 relative slack downwards, so a
+// tet at the bound within rounding counts as above).
+bool KeptTetAboveBound(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets, size_t t,
+                       const Labelling& lab, std::span<const double> comp_volume) {
+  const uint32_t c = lab.tet_component[t];
+  if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) return false;
+  const auto& q = tets[t];
+  const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
+  const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
+  return vol > comp_volume[c] * (1 - 1e-9);
+}
+
 void Refiner::CollectOversizedDelaunayTets(std::span<const Vec3> positions,
                                            std::span<const std::array<uint32_t, 4>> tets, size_t count,
                                            const Labelling& lab, std::span<const double> comp_volume) {
@@ -3472,16 +3485,12 @@ void Refiner::CollectOversizedDelaunayTets(std::span<const Vec3> positions,
   size_points_.clear();
   const geom::Box3& cube = omega_.cube();
   for (size_t t = 0; t < count && t < tets.size(); ++t) {
-    const uint32_t c = lab.tet_component[t];
-    if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) continue;
+    if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
     const auto& q = tets[t];
-    const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
-    const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
-    if (!(vol > comp_volume[c] * (1 - 1e-9))) continue;
-    const Vec3 o = geom::TetCircumcenter(a, b, cc, d);
+    const Vec3 o = geom::TetCircumcenter(positions[q[0]], positions[q[1]], positions[q[2]], positions[q[3]]);
     Vec3 x = o;
     for (int k = 0; k < 3; ++k) x[k] = std::clamp(x[k], cube.lo[k], cube.hi[k]);
-    size_points_.emplace_back(x, geom::Dist(o, a));
+    size_points_.emplace_back(x, geom::Dist(o, positions[q[0]]));
   }
   std::sort(size_points_.begin(), size_points_.end(), [](const auto& l, const auto& r) {
     return std::tie(l.first.x, l.first.y, l.first.z) < std::tie(r.first.x, r.first.y, r.first.z);
@@ -3511,12 +3520,8 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
     if (v != PointStore::kNoVertex && v < ball_of_vertex.size()) ball_of_vertex[v] = i;
   }
   for (size_t t = stitch_report_.outside_tets; t < tets.size(); ++t) {
-    const uint32_t c = lab.tet_component[t];
-    if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) continue;
+    if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
     const auto& q = tets[t];
-    const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
-    const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
-    if (!(vol > comp_volume[c] * (1 - 1e-9))) continue;
     std::array<uint32_t, 2> centres{}, others{};
     int nc = 0, no = 0;
     for (uint32_t v : q) {
@@ -3579,15 +3584,9 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
   if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
     size_t over = 0, over_out = 0;
     for (size_t t = 0; t < tets.size(); ++t) {
-      const uint32_t c = lab.tet_component[t];
-      if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) continue;
-      const auto& q = tets[t];
-      const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
-      const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
-      if (vol > comp_volume[c] * (1 - 1e-9)) {
-        ++over;
-        if (t < stitch_report_.outside_tets) ++over_out;
-      }
+      if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
+      ++over;
+      if (t < stitch_report_.outside_tets) ++over_out;
     }
     std::fprintf(stderr, "size pass: %zu stitched tets over (%zu outside), %zu repairs queued\n", over, over_out,
                  stitch_failures_.size());

@@ -64,6 +64,16 @@ std::vector<uint8_t> CreaseVertices(const plc::Plc& plc, const mesh::TetMesh& m)
   return flag;
 }
 
+// The largest tet volume of a mesh.
+double MaxTetVolume(const mesh::TetMesh& m) {
+  double vmax = 0;
+  for (const auto& t : m.tets) {
+    const geom::Vec3 a = m.positions[t[0]];
+    vmax = std::max(vmax, geom::Dot(m.positions[t[1]] - a, geom::Cross(m.positions[t[2]] - a, m.positions[t[3]] - a)) / 6);
+  }
+  return vmax;
+}
+
 struct CreaseMeshed {
   mesh::ConformityReport conformity;
   mesh::QualityReport quality;
@@ -347,11 +357,7 @@ TEST(CreaseMesh, KnifeEdgeWithMaxVolume) {
   ASSERT_TRUE(m.ok()) << m.status();
   const mesh::ConformityReport rep = mesh::CheckConformity(*plc, *m);
   EXPECT_TRUE(rep.ok()) << rep.Summary();
-  double vmax = 0;
-  for (const auto& t : m->tets) {
-    const geom::Vec3 a = m->positions[t[0]];
-    vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
-  }
+  const double vmax = MaxTetVolume(*m);
   EXPECT_LE(vmax, 1e-3 * (1 + 1e-9));
   // The bound is active: the mesh without it is coarser somewhere.
   absl::StatusOr<mesh::TetMesh> plain = core::MeshPlc(*plc, {});
@@ -386,11 +392,7 @@ TEST(CreaseMesh, MaxVolumeReachesTheStitchedTets) {
     ASSERT_TRUE(m.ok()) << name << ": " << m.status();
     const mesh::ConformityReport rep = mesh::CheckConformity(plc, *m);
     EXPECT_TRUE(rep.ok()) << name << ": " << rep.Summary();
-    double vmax = 0;
-    for (const auto& t : m->tets) {
-      const geom::Vec3 a = m->positions[t[0]];
-      vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
-    }
+    const double vmax = MaxTetVolume(*m);
     EXPECT_LE(vmax, 1e-5 * (1 + 1e-9)) << name;
     EXPECT_GT(m->stats.Get("svrc.stitch_size_repairs"), 0) << name << ": the stitched tets met the bound unrepaired";
     const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(plc, *m));
@@ -470,11 +472,7 @@ TEST(CreaseMesh, MildCreaseBudgetCoversOmegaWithKeepBoundingBox) {
   opt.keep_bounding_box = true;
   const mesh::ConformityReport rep = mesh::CheckConformity(*tetra, *m, opt);
   EXPECT_TRUE(rep.ok()) << rep.Summary();
-  double vmax = 0;
-  for (const auto& t : m->tets) {
-    const geom::Vec3 a = m->positions[t[0]];
-    vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
-  }
+  const double vmax = MaxTetVolume(*m);
   EXPECT_LE(vmax, 1e-2 * (1 + 1e-9));
   // More vertices than the input box's budget (20,016 + 8 / 1e-2) allowed.
   EXPECT_GT(m->positions.size(), 20016u + 800u);
@@ -505,11 +503,7 @@ TEST(CreaseMesh, KeepBoundingBoxHasNoFlatTetsAndMeetsMaxVolume) {
   ASSERT_TRUE(m.ok()) << m.status();
   const mesh::ConformityReport rep = mesh::CheckConformity(pair, *m, opt);
   EXPECT_TRUE(rep.ok()) << rep.Summary();
-  double vmax = 0;
-  for (const auto& t : m->tets) {
-    const geom::Vec3 a = m->positions[t[0]];
-    vmax = std::max(vmax, geom::Dot(m->positions[t[1]] - a, geom::Cross(m->positions[t[2]] - a, m->positions[t[3]] - a)) / 6);
-  }
+  const double vmax = MaxTetVolume(*m);
   EXPECT_LE(vmax, 1e-2 * (1 + 1e-9));
   const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(pair, *m));
   EXPECT_GT(q.crease.num_tets, 0u);
