@@ -11,6 +11,8 @@
 #include "core/mesh/quality.h"
 #include "core/plc/families.h"
 #include "core/plc/readers.h"
+#include "core/plc/validate.h"
+#include "core/svrc/refiner.h"
 #include "gtest/gtest.h"
 #include "tests/test_support.h"
 
@@ -204,6 +206,32 @@ TEST(PlcRefine, KeepBoundingBoxMeetsTheBoundsUpToTheBox) {
       EXPECT_LE(worst, vmax_bound * (1 + 1e-9));
     }
   }
+}
+
+// Refine-level keep_bounding_box (RefineOptions; svrc_sensitivity_bench uses
+// it for PLCs without facets): the whole Ω of M_Ω is the output, and cells
+// clipped by ∂Ω are sized by their corners inside Ω, so a tet at ∂Ω whose
+// circumcentre is outside Ω stayed above max_volume (cube.poly at 1e-2: a
+// tet of 0.0130, session 35). Once the cell test finds nothing, such tets
+// get their circumcentre clamped to Ω (RefineStats::clipped_size_points).
+TEST(PlcRefine, RefineLevelKeepBoundingBoxMeetsMaxVolumeAtTheBox) {
+  absl::StatusOr<plc::Plc> cube = plc::ReadPlcFile(testing::CorpusPath("a_convex/cube.poly"));
+  ASSERT_TRUE(cube.ok()) << cube.status();
+  absl::StatusOr<plc::FeatureComplex> complex = plc::PreparePlc(*cube, {}, {}, nullptr);
+  ASSERT_TRUE(complex.ok()) << complex.status();
+  refine::RefineOptions options;
+  options.tau = 4;
+  options.max_volume = 1e-2;
+  options.keep_bounding_box = true;
+  absl::StatusOr<refine::PointSetRefinement> r = refine::RefinePlc(*complex, options);
+  ASSERT_TRUE(r.ok()) << r.status();
+  double worst = 0;
+  for (const auto& t : r->tets) {
+    const geom::Vec3& a = r->positions[t[0]];
+    worst = std::max(worst, geom::Dot(r->positions[t[1]] - a, geom::Cross(r->positions[t[2]] - a, r->positions[t[3]] - a)) / 6);
+  }
+  EXPECT_LE(worst, 1e-2 * (1 + 1e-9));
+  EXPECT_GT(r->stats.clipped_size_points, 0u) << "the cell test alone met the bound: the case is gone";
 }
 
 // Same input and parameters, same output bytes (the container encodes every
