@@ -403,6 +403,29 @@ TEST(CreaseMesh, MaxVolumeReachesTheStitchedTets) {
   }
 }
 
+// A region's own max_volume on the collar path: the size passes after the
+// stitch read each tet's region bound (QueueOversizedStitchRepairs takes the
+// component's volume), stars and books included. crease_pair_30's box is one
+// region (its two quads are internal facets): a seed with attribute 7 and
+// max volume 1e-4 bounds every tet, and the region keeps its attribute.
+TEST(CreaseMesh, RegionMaxVolumeReachesTheStitchedTets) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  plc::Plc pair = plc::families::CreaseFacetPair(30);
+  pair.regions.push_back(plc::RegionSeed{geom::Vec3{0.1, 0.5, 0.5}, 7, 1e-4});
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(pair, {});
+  ASSERT_TRUE(m.ok()) << m.status();
+  const mesh::ConformityReport rep = mesh::CheckConformity(pair, *m);
+  EXPECT_TRUE(rep.ok()) << rep.Summary();
+  ASSERT_EQ(m->regions.size(), 1u);
+  EXPECT_EQ(m->regions[0].attribute, 7);
+  EXPECT_LE(MaxTetVolume(*m), 1e-4 * (1 + 1e-9));
+  EXPECT_GT(m->stats.Get("svrc.collars"), 0);
+  // One star was above the region's bound after the first stitch (session 35).
+  EXPECT_GT(m->stats.Get("svrc.stitch_size_repairs"), 0) << "no stitched tet above 1e-4: the case is gone";
+}
+
 // keep_bounding_box through the collar path: the mesh fills Ω, so its hull
 // faces are boundary. api.cc's own conformity check ran without the option
 // and refused every creased input with --keep-bounding-box (knife_edge.poly:
