@@ -3519,6 +3519,23 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
     const uint32_t v = points_.VertexIn(collar_centre_[i], kOmegaMesh);
     if (v != PointStore::kNoVertex && v < ball_of_vertex.size()) ball_of_vertex[v] = i;
   }
+  // FindContaining names the lowest ball with x strictly inside; a point
+  // constructed on a sphere or circle can be inside its own ball(s) by
+  // rounding, which does not take it off S.
+  auto on_s = [&](const Vec3& x, uint32_t i, uint32_t j) {
+    const uint32_t o = collars_.FindContaining(x);
+    return o == CollarIndex::kNone || o == i || o == j;
+  };
+  auto circle_point = [&](uint32_t i, uint32_t j, const Vec3& near, Vec3* x) {
+    Circle3 circle;
+    if (!SphereSphereCircle(collars_.ball(i), collars_.ball(j), &circle)) return false;
+    const Vec3 dm = near - circle.center;
+    const Vec3 in_plane = dm - geom::Dot(dm, circle.normal) * circle.normal;
+    const double len = geom::Norm(in_plane);
+    if (!(len > 0)) return false;
+    *x = circle.center + (circle.radius / len) * in_plane;
+    return on_s(*x, i, j);
+  };
   for (size_t t = stitch_report_.outside_tets; t < tets.size(); ++t) {
     if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
     const auto& q = tets[t];
@@ -3532,23 +3549,6 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
         others[no++] = v;
       }
     }
-    // FindContaining names the lowest ball with x strictly inside; a point
-    // constructed on a sphere or circle can be inside its own ball(s) by
-    // rounding, which does not take it off S.
-    auto on_s = [&](const Vec3& x, uint32_t i, uint32_t j) {
-      const uint32_t o = collars_.FindContaining(x);
-      return o == CollarIndex::kNone || o == i || o == j;
-    };
-    auto circle_point = [&](uint32_t i, uint32_t j, const Vec3& near, Vec3* x) {
-      Circle3 circle;
-      if (!SphereSphereCircle(collars_.ball(i), collars_.ball(j), &circle)) return false;
-      const Vec3 dm = near - circle.center;
-      const Vec3 in_plane = dm - geom::Dot(dm, circle.normal) * circle.normal;
-      const double len = geom::Norm(in_plane);
-      if (!(len > 0)) return false;
-      *x = circle.center + (circle.radius / len) * in_plane;
-      return on_s(*x, i, j);
-    };
     if (nc == 1) {
       // A star: its face's centroid projected from the ball's centre; when
       // that lies in a neighbouring ball, the face is at their circle: its

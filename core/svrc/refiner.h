@@ -343,7 +343,7 @@ struct RefineStats {
   uint64_t points_12_without_ball = 0;  // (1,2) points that got no ball (inside another, or no size)
   uint64_t stitch_hidden_balls = 0;     // balls inside their chain neighbours' union, left out of the stitch
   uint64_t stitch_flat_tets = 0;        // stars / books refused as flat, over every stitch attempt
-  uint64_t stitch_size_repairs = 0;     // points of S for stars / books above max_volume (all size passes)
+  uint64_t stitch_size_repairs = 0;     // points of S queued for stars / books above max_volume (all size passes)
   uint64_t clipped_size_points = 0;     // points of Ω for kept Delaunay tets above max_volume the cell test missed
   uint64_t neck_splits = 0;        // crease points between balls meeting below π/2 (Lemma 17)
   uint64_t collar_rounds = 0;      // rounds of COLLAR events (3D + facet arcs)

@@ -25,6 +25,9 @@ struct StitchBall {
   delaunay::VertexId centre;
 };
 
+// The default of StitchOptions::min_flatness (see StitchedTetFlatness).
+inline constexpr double kFlatStitchedTet = 1e-9;
+
 // Quality preconditions: a hole-boundary face whose representation angle or
 // RepBall is too large is reported as a failure at its representation point
 // (a COLLAR event for the refiner, thesis §3.1.2) instead of being stitched.
@@ -33,9 +36,6 @@ struct StitchBall {
 // 1-Lipschitz minorant of Definition 32's rad). For a book the "RepBall" is
 // max(|xa|, |xb|) at the circle point x and the angle is the circle's
 // (Definition 34). Pass π/2 and +∞ to switch both checks off.
-// The default of StitchOptions::min_flatness (see StitchedTetFlatness).
-inline constexpr double kFlatStitchedTet = 1e-9;
-
 struct StitchOptions {
   double max_rep_angle = std::numbers::pi / 6;
   double max_rep_ratio = 0.3;
