@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <new>
+#include <string_view>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -97,6 +98,10 @@ absl::StatusOr<mesh::TetMesh> MeshPointSet(const plc::Plc& plc, const ProgressCa
 
 // Creases of this angle (degrees) and more are refined through without collars; sharper ones get collars.
 constexpr double kCollarAngleDeg = 45;
+
+// The phase of the second refinement when one without collars overran its
+// budget (Progress::phase).
+constexpr const char* kRefineCollarsPhase = "refine-collars";
 
 // The first crease of the complex, as "crease at segment (a, b): features meet
 // at X degrees" / "crease at point i (x, y, z)"; empty if none.
@@ -402,8 +407,12 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
       return absl::OkStatus();
     };
   }
+  // After a mild-crease fallback (below) the second run's "refine" reports
+  // are "refine-collars": within one phase the counters only increase.
+  bool rerun = false;
   options.progress = [&](const char* phase, uint64_t vertices, uint64_t queue, double radius) {
-    report(phase, vertices, queue, radius);
+    report(rerun && std::string_view(phase) == refine::refine_phase::kRefine ? kRefineCollarsPhase : phase, vertices,
+           queue, radius);
   };
   report("refine", 0, 0, 0);
   // Creases (Definitions 4-5). Mild ones (>= kCollarAngleDeg) are refined
@@ -446,7 +455,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
     mild_budget = options.max_vertices;
     use_collars = true;
     set_collar_options();
-    report("refine", 0, 0, 0);
+    rerun = true;
+    report(kRefineCollarsPhase, 0, 0, 0);
     refined = refine::RefinePlc(*complex, options);
   }
   if (!refined.ok()) {

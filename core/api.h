@@ -56,7 +56,9 @@ struct MeshParams {
 // A snapshot of progress, reported from the meshing thread.
 struct Progress {
   // "validate", "refine", with creases "collar", "stitch", "stitch-repair"
-  // (refine::refine_phase), then "assemble", "check", "done".
+  // (refine::refine_phase), then "assemble", "check", "done". Mild creases
+  // (45°–90°) whose refinement without collars overruns its budget start
+  // again with collars: "refine-collars", then "collar" and on.
   std::string phase;
   uint64_t vertices = 0;             // vertices in the output mesh so far
   uint64_t queue_size = 0;           // pending work events

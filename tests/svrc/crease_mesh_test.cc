@@ -81,9 +81,10 @@ struct CreaseMeshed {
   mesh::MeshStats stats;
 };
 
-CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what, const core::MeshParams& params = {}) {
+CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what, const core::MeshParams& params = {},
+                          const core::ProgressCallback& progress = {}) {
   CreaseMeshed out;
-  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(plc, params);
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(plc, params, progress);
   EXPECT_TRUE(m.ok()) << what << ": " << m.status();
   if (!m.ok()) return out;
   out.tets = m->tets.size();
@@ -889,9 +890,27 @@ TEST(CreaseMesh, MildCreasesThatDoNotSettleTakeCollars) {
 #endif
   absl::StatusOr<plc::Plc> cut = plc::ReadPlcBytes(kBoxCutAt51Degrees, plc::InputFormat::kPoly, "box_cut_51.poly");
   ASSERT_TRUE(cut.ok()) << cut.status();
-  const CreaseMeshed out = MeshAndCheck(*cut, "box cut at 51 degrees");
+  // The second run reports its own phase: within one phase the vertex
+  // count never falls (service.proto's Progress).
+  std::vector<std::pair<std::string, uint64_t>> reports;
+  const CreaseMeshed out = MeshAndCheck(*cut, "box cut at 51 degrees", {}, [&](const core::Progress& p) {
+    reports.emplace_back(p.phase, p.vertices);
+  });
   EXPECT_EQ(out.stats.Get("mild_crease_budget_overrun"), 20056);
   EXPECT_GT(out.stats.Get("svrc.collars"), 0);
+  std::vector<std::string> phases;
+  for (size_t i = 0; i < reports.size(); ++i) {
+    if (i == 0 || reports[i].first != reports[i - 1].first) {
+      phases.push_back(reports[i].first);
+    } else {
+      EXPECT_GE(reports[i].second, reports[i - 1].second) << "phase " << reports[i].first << ", report " << i;
+    }
+  }
+  ASSERT_GE(phases.size(), 4u);
+  EXPECT_EQ(phases[0], "validate");
+  EXPECT_EQ(phases[1], "refine");
+  EXPECT_EQ(phases[2], "refine-collars");
+  EXPECT_EQ(phases[3], "collar");
   // A budget the caller set is the caller's: no second run.
   core::MeshParams params;
   params.max_vertices = 5000;
