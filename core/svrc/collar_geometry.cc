@@ -147,6 +147,15 @@ Vec3 CirclePoint(const Circle3& c, double t) {
   return c.center + c.radius * (std::cos(t) * u + std::sin(t) * w);
 }
 
+bool NearestCirclePoint(const Circle3& c, const Vec3& p, Vec3* x) {
+  const Vec3 d = p - c.center;
+  const Vec3 in_plane = d - geom::Dot(d, c.normal) * c.normal;
+  const double len = geom::Norm(in_plane);
+  if (!(len > 0)) return false;
+  *x = c.center + (c.radius / len) * in_plane;
+  return true;
+}
+
 std::vector<Arc> ClipCircleByBalls(const Circle3& circle, std::span<const CollarBall> others) {
   Vec3 u, w;
   CircleFrame(circle, &u, &w);

@@ -74,6 +74,11 @@ int SegmentCircleInPlane(const Vec3& a, const Vec3& b, const Circle3& circle, do
 void CircleFrame(const Circle3& c, Vec3* u, Vec3* w);
 Vec3 CirclePoint(const Circle3& c, double t);
 
+// The point of `c` nearest p: p's offset from the centre projected onto the
+// circle's plane, scaled to the radius. False when that projection is zero
+// (p on the axis: every point of the circle is nearest).
+bool NearestCirclePoint(const Circle3& c, const Vec3& p, Vec3* x);
+
 // An arc [t0, t1] of angles (t0 < t1 ≤ t0 + 2π) in the CircleFrame.
 struct Arc {
   double t0 = 0, t1 = 0;

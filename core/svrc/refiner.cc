@@ -3529,12 +3529,7 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
   auto circle_point = [&](uint32_t i, uint32_t j, const Vec3& near, Vec3* x) {
     Circle3 circle;
     if (!SphereSphereCircle(collars_.ball(i), collars_.ball(j), &circle)) return false;
-    const Vec3 dm = near - circle.center;
-    const Vec3 in_plane = dm - geom::Dot(dm, circle.normal) * circle.normal;
-    const double len = geom::Norm(in_plane);
-    if (!(len > 0)) return false;
-    *x = circle.center + (circle.radius / len) * in_plane;
-    return on_s(*x, i, j);
+    return NearestCirclePoint(circle, near, x) && on_s(*x, i, j);
   };
   for (size_t t = stitch_report_.outside_tets; t < tets.size(); ++t) {
     if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;

@@ -467,12 +467,10 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
     const int c = facet_crossings(a, b, cp, xs);
     if (c != 1) {
       // Report a point of S: the circle point nearest the edge's midpoint.
+      // (A midpoint on the circle's axis is equally near every point of it:
+      // angle 0 of its frame.)
       Vec3 where = xs[0];
-      if (c == 0) {
-        const Vec3 d = mid - cp.circle.center;
-        const Vec3 in_plane = d - geom::Dot(d, cp.circle.normal) * cp.circle.normal;
-        where = cp.circle.center + cp.circle.radius * Unit(in_plane);
-      }
+      if (c == 0 && !NearestCirclePoint(cp.circle, mid, &where)) where = CirclePoint(cp.circle, 0);
       fail(Kind::kCircleCrossing, where, cp.i,
            absl::StrCat("circle of balls ", cp.i, ", ", cp.j, " crosses the Voronoi facet of ",
                         edge_name, " ", c, " times (expected once)"));
