@@ -922,5 +922,62 @@ TEST(CreaseMesh, MildCreasesThatDoNotSettleTakeCollars) {
       << m.status();
 }
 
+// Three triangles floating in the unit box (session 36's random "float"
+// family, seed 4): their acute corners are crease points with vertex
+// collars. The sliver flips compared a new tet touching a crease with the
+// largest dihedral of every tet they replaced, slivers away from the creases
+// included (178.6° here), so a star of 140.5° became a tet of 146.8° at a
+// corner: above every stitched star, which MeshAndCheck asserts against. Now
+// only the replaced tets that touch a crease count (sliver.cc
+// RaisesCreaseAngle).
+constexpr char kFloatingTriangles[] = R"(17 3 0 0
+1 0 0 0
+2 1 0 0
+3 1 1 0
+4 0 1 0
+5 0 0 1
+6 1 0 1
+7 1 1 1
+8 0 1 1
+9 0.3821054919334119 0.6526220274528415 0.4804074375209068
+10 0.631822407601147 0.6523778262782637 0.8587665297820166
+11 0.8191656653535178 0.6521914680557537 0.6239069704105709
+12 0.6714658584046229 0.5973460175969458 0.38747972767554356
+13 0.6876970524200203 0.49907836965369967 0.4611866400680232
+14 0.6582191489036809 0.4822554366382304 0.494022412020066
+15 0.3060335265833909 0.37196174477484883 0.5750824714781881
+16 0.3060039897461857 0.4012136616413203 0.5560592118458929
+17 0.3059098409920264 0.5142957380271056 0.8041550160162144
+9 1
+1 0 1
+4 1 4 3 2
+1 0 1
+4 5 6 7 8
+1 0 1
+4 1 2 6 5
+1 0 1
+4 2 3 7 6
+1 0 1
+4 3 4 8 7
+1 0 1
+4 4 1 5 8
+1 0 3
+3 9 10 11
+1 0 3
+3 12 13 14
+1 0 3
+3 15 16 17
+0
+0
+)";
+
+TEST(CreaseMesh, SliverFlipsKeepTheStitchedDihedralsAtFloatingCorners) {
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kFloatingTriangles, plc::InputFormat::kPoly, "float_4.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  const CreaseMeshed out = MeshAndCheck(*plc, "three floating triangles");
+  EXPECT_EQ(out.stats.Get("svrc.vertex_collars"), 7);
+  EXPECT_GT(out.stats.Get("sliver.rejected_crease_angle"), 0);
+}
+
 }  // namespace
 }  // namespace svrc
