@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/api.h"
 #include "core/mesh/conformity.h"
+#include "core/mesh/crease_vertices.h"
 #include "core/mesh/quality.h"
 #include "core/mesh/stats_payload.h"
 #include "core/plc/families.h"
@@ -28,41 +29,6 @@
 
 namespace svrc {
 namespace {
-
-// Vertices of the output lying on a crease (an input point flagged crease, or
-// a point on a crease segment): exact position match against the input's
-// crease points and an exact on-segment test for the rest.
-std::vector<uint8_t> CreaseVertices(const plc::Plc& plc, const mesh::TetMesh& m) {
-  std::vector<uint8_t> flag(m.positions.size(), 0);
-  absl::StatusOr<plc::FeatureComplex> c = plc::PreparePlc(plc, {}, {}, nullptr);
-  EXPECT_TRUE(c.ok()) << c.status();
-  if (!c.ok()) return flag;
-  std::set<std::tuple<double, double, double>> points;
-  for (const plc::FeaturePoint& p : c->points) {
-    if (p.crease) points.insert({p.p.x, p.p.y, p.p.z});
-  }
-  for (size_t i = 0; i < m.positions.size(); ++i) {
-    const geom::Vec3& x = m.positions[i];
-    if (points.count({x.x, x.y, x.z})) {
-      flag[i] = 1;
-      continue;
-    }
-    for (const plc::FeatureSegment& s : c->segments) {
-      if (!s.crease) continue;
-      const geom::Vec3 a = c->points[s.a].p, b = c->points[s.b].p;
-      // On the segment's line (collinear up to rounding of the Steiner point)
-      // and between its ends.
-      const geom::Vec3 d = b - a;
-      const double t = geom::Dot(x - a, d) / geom::Dot(d, d);
-      if (t <= 0 || t >= 1) continue;
-      if (geom::Dist(a + t * d, x) <= 1e-12 * std::sqrt(geom::Dot(d, d))) {
-        flag[i] = 1;
-        break;
-      }
-    }
-  }
-  return flag;
-}
 
 // The largest tet volume of a mesh.
 double MaxTetVolume(const mesh::TetMesh& m) {
@@ -89,7 +55,7 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what, const co
   if (!m.ok()) return out;
   out.tets = m->tets.size();
   out.conformity = mesh::CheckConformity(plc, *m);
-  out.quality = mesh::ComputeQuality(*m, CreaseVertices(plc, *m));
+  out.quality = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(plc, *m));
   EXPECT_TRUE(out.conformity.ok()) << what << ": " << out.conformity.Summary();
   EXPECT_GT(out.quality.crease.num_tets, 0u) << what << ": no tet touches a crease (collars not used?)";
   // The radius-edge bound holds away from the creases (thesis Theorem 4).
@@ -364,7 +330,7 @@ TEST(CreaseMesh, KnifeEdgeWithMaxVolume) {
   absl::StatusOr<mesh::TetMesh> plain = core::MeshPlc(*plc, {});
   ASSERT_TRUE(plain.ok()) << plain.status();
   EXPECT_GT(m->tets.size(), plain->tets.size());
-  const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(*plc, *m));
+  const mesh::QualityReport q = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(*plc, *m));
   EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9));
   std::printf("knife_edge --max-volume 1e-3: %zu tets (%zu without), max volume %.3g\n", m->tets.size(),
               plain->tets.size(), vmax);
@@ -396,7 +362,7 @@ TEST(CreaseMesh, MaxVolumeReachesTheStitchedTets) {
     const double vmax = MaxTetVolume(*m);
     EXPECT_LE(vmax, 1e-5 * (1 + 1e-9)) << name;
     EXPECT_GT(m->stats.Get("svrc.stitch_size_repairs"), 0) << name << ": the stitched tets met the bound unrepaired";
-    const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(plc, *m));
+    const mesh::QualityReport q = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(plc, *m));
     EXPECT_GT(q.crease.num_tets, 0u) << name;
     EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9)) << name;
     std::printf("%s --max-volume 1e-5: %zu tets, max volume %.4g, %g stitch size repairs\n", name.c_str(),
@@ -458,7 +424,7 @@ TEST(CreaseMesh, KnifeEdgeKeepsTheBoundingBox) {
   // Ω's cube is six facets of the PLC (session 35): the bound holds up to
   // it (before, Ω's scaffolding next to ∂Ω was not refined for quality —
   // cube.poly with the box had radius-edge 44 there).
-  const mesh::QualityReport q = mesh::ComputeQuality(*boxed, CreaseVertices(*plc, *boxed));
+  const mesh::QualityReport q = mesh::ComputeQuality(*boxed, mesh::CreaseVertexFlags(*plc, *boxed));
   EXPECT_GT(q.crease.num_tets, 0u);
   EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9));
 }
@@ -529,7 +495,7 @@ TEST(CreaseMesh, KeepBoundingBoxHasNoFlatTetsAndMeetsMaxVolume) {
   EXPECT_TRUE(rep.ok()) << rep.Summary();
   const double vmax = MaxTetVolume(*m);
   EXPECT_LE(vmax, 1e-2 * (1 + 1e-9));
-  const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(pair, *m));
+  const mesh::QualityReport q = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(pair, *m));
   EXPECT_GT(q.crease.num_tets, 0u);
   EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9));
   std::printf("crease_pair_30 --keep-bounding-box --max-volume 1e-2: %zu tets, max volume %.4g, radius-edge away "
@@ -571,7 +537,7 @@ TEST(CreaseMesh, SizeCriterionMeshesKnifeEdge) {
   ASSERT_TRUE(m.ok()) << m.status();
   const mesh::ConformityReport rep = mesh::CheckConformity(*plc, *m);
   EXPECT_TRUE(rep.ok()) << rep.Summary();
-  const mesh::QualityReport q = mesh::ComputeQuality(*m, CreaseVertices(*plc, *m));
+  const mesh::QualityReport q = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(*plc, *m));
   EXPECT_GT(q.crease.num_tets, 0u);
   EXPECT_LE(q.other.radius_edge.max, 2.0 * (1 + 1e-9));
   EXPECT_GT(m->stats.Get("svrc.collar_repairs.size"), 0);

@@ -1,0 +1,293 @@
+#!/usr/bin/env python3
+"""Random PLCs for svrc's robustness sweep (bench/svrc/random_sweep.sh).
+
+random_plcs.py KIND SEED OUT.poly writes one TetGen .poly file, the same
+bytes for the same KIND and SEED (Python's random.Random; floats written
+with repr, so they round-trip). Kinds (all inside or on the unit box):
+  pts       isolated points, some in close pairs or near a wall (1e-2..1e-6)
+  segs      free segments and isolated points
+  float     1-3 triangles/squares floating inside (acute corners: crease points)
+  cut       the box cut by a random plane (creases where it meets the walls)
+  tet       a random tetrahedron, 40% of them flattened (sharp dihedrals)
+  mixed     a cut plus free segments and points
+  hull      the convex hull of 5-12 random points, 30% of them squashed
+  segfacet  segments standing on the floor at 2-89 degrees
+  near      features 1e-2..1e-7 from a wall or from each other
+Some outputs are invalid PLCs (intersecting features); the sweep validates
+first and skips them.
+"""
+import random, sys, math, os
+
+BOX = [(0,0,0),(1,0,0),(1,1,0),(0,1,0),(0,0,1),(1,0,1),(1,1,1),(0,1,1)]
+FACES = [[0,3,2,1],[4,5,6,7],[0,1,5,4],[1,2,6,5],[2,3,7,6],[3,0,4,7]]
+EDGES = [(0,1),(1,2),(2,3),(3,0),(4,5),(5,6),(6,7),(7,4),(0,4),(1,5),(2,6),(3,7)]
+
+def write_poly(path, nodes, facets, holes=(), regions=()):
+    with open(path, 'w') as f:
+        f.write(f"{len(nodes)} 3 0 0\n")
+        for i, p in enumerate(nodes):
+            f.write(f"{i+1} {p[0]!r} {p[1]!r} {p[2]!r}\n")
+        f.write(f"{len(facets)} 1\n")
+        for polys, marker in facets:
+            f.write(f"{len(polys)} 0 {marker}\n")
+            for poly in polys:
+                f.write(f"{len(poly)} " + " ".join(str(v+1) for v in poly) + "\n")
+        f.write(f"{len(holes)}\n")
+        for i, h in enumerate(holes):
+            f.write(f"{i+1} {h[0]!r} {h[1]!r} {h[2]!r}\n")
+        f.write(f"{len(regions)}\n")
+        for i, r in enumerate(regions):
+            f.write(f"{i+1} {r[0]!r} {r[1]!r} {r[2]!r} {r[3]} {r[4]!r}\n")
+
+def rnd_interior(rng, lo=0.05, hi=0.95):
+    return tuple(rng.uniform(lo, hi) for _ in range(3))
+
+def box_facets(extra=None):
+    extra = extra or {}
+    return [([f] + extra.get(i, []), 1) for i, f in enumerate(FACES)]
+
+def gen_pts(rng):
+    nodes = list(BOX)
+    n = rng.randint(1, 30)
+    for _ in range(n):
+        p = rnd_interior(rng)
+        nodes.append(p)
+        r = rng.random()
+        if r < 0.2:  # a close pair
+            e = 10 ** -rng.uniform(2, 6)
+            d = [rng.gauss(0, 1) for _ in range(3)]
+            l = math.sqrt(sum(x*x for x in d))
+            nodes.append(tuple(p[k] + e * d[k] / l for k in range(3)))
+        elif r < 0.35:  # a point near a face
+            e = 10 ** -rng.uniform(2, 6)
+            k = rng.randrange(3)
+            q = list(p); q[k] = e if rng.random() < 0.5 else 1 - e
+            nodes.append(tuple(q))
+    return nodes, box_facets()
+
+def gen_segs(rng):
+    nodes = list(BOX)
+    facets = box_facets()
+    for _ in range(rng.randint(1, 5)):
+        a = rnd_interior(rng); b = rnd_interior(rng)
+        nodes += [a, b]
+        facets.append(([[len(nodes)-2, len(nodes)-1]], 2))
+    for _ in range(rng.randint(0, 5)):
+        nodes.append(rnd_interior(rng))
+    return nodes, facets
+
+def plane_basis(n):
+    a = (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 1.0, 0.0)
+    u = cross(n, a); lu = norm(u); u = tuple(x/lu for x in u)
+    v = cross(n, u)
+    return u, v
+
+def cross(a, b):
+    return (a[1]*b[2]-a[2]*b[1], a[2]*b[0]-a[0]*b[2], a[0]*b[1]-a[1]*b[0])
+
+def norm(a):
+    return math.sqrt(sum(x*x for x in a))
+
+def gen_float(rng):
+    nodes = list(BOX)
+    facets = box_facets()
+    k = rng.randint(1, 3)
+    for _ in range(k):
+        c = rnd_interior(rng, 0.3, 0.7)
+        n = [rng.gauss(0, 1) for _ in range(3)]; l = norm(n); n = tuple(x/l for x in n)
+        # sometimes nearly axis aligned
+        if rng.random() < 0.3:
+            n = list(n); j = rng.randrange(3)
+            n = [x * 1e-3 if i != j else 1.0 for i, x in enumerate(n)]
+            l = norm(n); n = tuple(x/l for x in n)
+        u, v = plane_basis(n)
+        m = rng.choice([3, 3, 4])
+        r = rng.uniform(0.05, 0.25)
+        if m == 3:
+            angs = sorted(rng.uniform(0, 2*math.pi) for _ in range(3))
+        else:
+            angs = [0, math.pi/2, math.pi, 3*math.pi/2]
+        base = len(nodes)
+        for a in angs:
+            nodes.append(tuple(c[i] + r*(math.cos(a)*u[i] + math.sin(a)*v[i]) for i in range(3)))
+        facets.append(([list(range(base, base+len(angs)))], 3))
+    return nodes, facets
+
+def gen_cut(rng):
+    nodes = list(BOX)
+    c = rnd_interior(rng, 0.35, 0.65)
+    n = [rng.gauss(0, 1) for _ in range(3)]; l = norm(n); n = tuple(x/l for x in n)
+    d = sum(n[i]*c[i] for i in range(3))
+    s = [sum(n[i]*p[i] for i in range(3)) - d for p in BOX]
+    if min(abs(x) for x in s) < 1e-3:
+        return None
+    edge_pt = {}
+    for (a, b) in EDGES:
+        if (s[a] < 0) != (s[b] < 0):
+            t = s[a] / (s[a] - s[b])
+            p = tuple(BOX[a][i] + t*(BOX[b][i]-BOX[a][i]) for i in range(3))
+            edge_pt[(a, b)] = len(nodes); edge_pt[(b, a)] = len(nodes)
+            nodes.append(p)
+    facets = []
+    for fi, f in enumerate(FACES):
+        ring = []
+        on = []
+        for j in range(4):
+            a, b = f[j], f[(j+1) % 4]
+            ring.append(a)
+            if (a, b) in edge_pt:
+                ring.append(edge_pt[(a, b)]); on.append(edge_pt[(a, b)])
+        polys = [ring]
+        if len(on) == 2:
+            polys.append(on)
+        facets.append((polys, 1))
+    cut = sorted(set(edge_pt.values()))
+    cen = tuple(sum(nodes[i][k] for i in cut)/len(cut) for k in range(3))
+    u, v = plane_basis(n)
+    cut.sort(key=lambda i: math.atan2(sum((nodes[i][k]-cen[k])*v[k] for k in range(3)), sum((nodes[i][k]-cen[k])*u[k] for k in range(3))))
+    facets.append(([cut], 5))
+    return nodes, facets
+
+def gen_tet(rng):
+    while True:
+        p = [rnd_interior(rng, 0, 1) for _ in range(4)]
+        if rng.random() < 0.4:  # flatten: pull the 4th point toward the plane of the others
+            a, b, c = p[0], p[1], p[2]
+            nn = cross(tuple(b[i]-a[i] for i in range(3)), tuple(c[i]-a[i] for i in range(3)))
+            l = norm(nn)
+            if l < 1e-6: continue
+            nn = tuple(x/l for x in nn)
+            h = sum((p[3][i]-a[i])*nn[i] for i in range(3))
+            f = 10 ** -rng.uniform(0.5, 2.5)
+            p[3] = tuple(p[3][i] - (1-f)*h*nn[i] for i in range(3))
+        vol = sum(cross(tuple(p[1][i]-p[0][i] for i in range(3)), tuple(p[2][i]-p[0][i] for i in range(3)))[k]*(p[3][k]-p[0][k]) for k in range(3))
+        if abs(vol) > 1e-6:
+            break
+    if vol < 0:
+        p[1], p[2] = p[2], p[1]
+    # faces outward: (0,2,1),(0,1,3),(1,2,3),(0,3,2)
+    facets = [([[0,2,1]],1),([[0,1,3]],1),([[1,2,3]],1),([[0,3,2]],1)]
+    return p, facets
+
+def gen_mixed(rng):
+    r = gen_cut(rng)
+    if r is None:
+        return None
+    nodes, facets = r
+    for _ in range(rng.randint(0, 2)):
+        a = rnd_interior(rng); b = rnd_interior(rng)
+        nodes += [a, b]
+        facets.append(([[len(nodes)-2, len(nodes)-1]], 2))
+    for _ in range(rng.randint(0, 4)):
+        nodes.append(rnd_interior(rng))
+    return nodes, facets
+
+GENS = dict(pts=gen_pts, segs=gen_segs, float=gen_float, cut=gen_cut, tet=gen_tet, mixed=gen_mixed)
+
+
+def sub(a, b): return (a[0]-b[0], a[1]-b[1], a[2]-b[2])
+def dot(a, b): return a[0]*b[0]+a[1]*b[1]+a[2]*b[2]
+
+def hull(pts):
+    """Incremental convex hull (small n); returns outward triangles or None if degenerate."""
+    n = len(pts)
+    def vol(a, b, c, d):
+        return dot(cross(sub(pts[b], pts[a]), sub(pts[c], pts[a])), sub(pts[d], pts[a]))
+    if abs(vol(0, 1, 2, 3)) < 1e-9:
+        return None
+    faces = [(0, 1, 2), (0, 2, 3), (0, 3, 1), (1, 3, 2)]
+    if vol(0, 1, 2, 3) > 0:
+        faces = [(a, c, b) for (a, b, c) in faces]
+    for i in range(4, n):
+        vis = [f for f in faces if vol(f[0], f[1], f[2], i) > 1e-12]
+        if not vis:
+            continue
+        edges = {}
+        for f in vis:
+            for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0])):
+                edges[e] = edges.get(e, 0) + 1
+        horizon = [e for e in edges if (e[1], e[0]) not in edges]
+        faces = [f for f in faces if f not in vis] + [(e[0], e[1], i) for e in horizon]
+    used = sorted({v for f in faces for v in f})
+    remap = {v: k for k, v in enumerate(used)}
+    return [pts[v] for v in used], [tuple(remap[v] for v in f) for f in faces]
+
+def gen_hull(rng):
+    m = rng.randint(5, 12)
+    pts = [tuple(rng.uniform(0, 1) for _ in range(3)) for _ in range(m)]
+    if rng.random() < 0.3:  # squash one axis: thin slabs, sharp edges
+        k = rng.randrange(3); s = 10 ** -rng.uniform(0.5, 1.5)
+        pts = [tuple(p[i] * (s if i == k else 1) for i in range(3)) for p in pts]
+    r = hull(pts)
+    if r is None:
+        return None
+    nodes, tris = r
+    return nodes, [([list(t)], 1) for t in tris]
+
+GENS['hull'] = gen_hull
+
+def gen_segfacet(rng):
+    """Segments standing on the floor (z=0) at random angles, some grazing."""
+    nodes = list(BOX)
+    facets = box_facets()
+    floor_extra = []
+    for _ in range(rng.randint(1, 3)):
+        a = (rng.uniform(0.1, 0.9), rng.uniform(0.1, 0.9), 0.0)
+        ang = rng.choice([rng.uniform(2, 89), rng.uniform(20, 89)]) * math.pi / 180
+        az = rng.uniform(0, 2 * math.pi)
+        L = rng.uniform(0.1, 0.5)
+        b = (a[0] + L * math.cos(ang) * math.cos(az), a[1] + L * math.cos(ang) * math.sin(az), L * math.sin(ang))
+        if not all(0.02 < b[i] < 0.98 for i in range(3)):
+            continue
+        a2 = (min(max(a[0] + rng.uniform(-0.08, 0.08), 0.02), 0.98), min(max(a[1] + rng.uniform(-0.08, 0.08), 0.02), 0.98), 0.0)
+        nodes += [a, b, a2]
+        floor_extra.append([len(nodes) - 3, len(nodes) - 1])
+        facets.append(([[len(nodes) - 3, len(nodes) - 2]], 2))
+    if not floor_extra:
+        return None
+    facets[0] = (facets[0][0] + floor_extra, 1)
+    return nodes, facets
+
+GENS['segfacet'] = gen_segfacet
+
+
+def gen_near(rng):
+    """Features very close to the walls or to each other (large spread)."""
+    nodes = list(BOX)
+    facets = box_facets()
+    kind = rng.randrange(3)
+    gap = 10 ** -rng.uniform(2, 7)
+    if kind == 0:  # a triangle nearly parallel to the floor, gap above it, tilted by up to 1 degree
+        tilt = math.radians(rng.uniform(0, 1))
+        c = (rng.uniform(0.3, 0.7), rng.uniform(0.3, 0.7))
+        r = rng.uniform(0.1, 0.25)
+        base = len(nodes)
+        for a in sorted(rng.uniform(0, 2 * math.pi) for _ in range(3)):
+            x, y = c[0] + r * math.cos(a), c[1] + r * math.sin(a)
+            nodes.append((x, y, gap + r * (1 + math.cos(a)) * math.tan(tilt)))
+        facets.append(([list(range(base, base + 3))], 3))
+    elif kind == 1:  # a free segment ending gap away from a wall
+        a = rnd_interior(rng, 0.2, 0.8)
+        b = (a[0] + rng.uniform(-0.2, 0.2), a[1] + rng.uniform(-0.2, 0.2), gap)
+        nodes += [a, b]
+        facets.append(([[len(nodes) - 2, len(nodes) - 1]], 2))
+    else:  # two floating triangles nearly touching
+        c = rnd_interior(rng, 0.35, 0.65)
+        base = len(nodes)
+        for k in range(2):
+            z = c[2] + (gap if k else 0)
+            rr = rng.uniform(0.1, 0.2)
+            for a in sorted(rng.uniform(0, 2 * math.pi) for _ in range(3)):
+                nodes.append((c[0] + rr * math.cos(a), c[1] + rr * math.sin(a), z + rng.uniform(-1, 1) * gap * 0.4))
+            facets.append(([list(range(base + 3 * k, base + 3 * k + 3))], 3))
+    return nodes, facets
+
+GENS['near'] = gen_near
+
+if __name__ == '__main__':
+    kind, seed, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+    rng = random.Random(seed * 1000 + list(GENS).index(kind))
+    r = None
+    while r is None:
+        r = GENS[kind](rng)
+    write_poly(out, *r)
