@@ -945,5 +945,37 @@ TEST(CreaseMesh, SliverFlipsKeepTheStitchedDihedralsAtFloatingCorners) {
   EXPECT_GT(out.stats.Get("sliver.rejected_crease_angle"), 0);
 }
 
+// mesh::CreaseVertexFlags walks each crease segment's chain of mesh edges;
+// on a conforming mesh that flags exactly the vertices a brute-force test
+// finds: at a crease point, or on a crease segment's line (within 1e-12 of
+// its length) strictly between its ends.
+TEST(CreaseMesh, CreaseVertexFlagsMatchTheGeometricTest) {
+  const std::optional<plc::Plc> plc = plc::families::CreaseFacetPair(30);
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(*plc, {});
+  ASSERT_TRUE(m.ok()) << m.status();
+  absl::StatusOr<plc::FeatureComplex> c = plc::PreparePlc(*plc, {}, {}, nullptr);
+  ASSERT_TRUE(c.ok()) << c.status();
+  std::vector<uint8_t> brute(m->positions.size(), 0);
+  size_t on_segments = 0;
+  for (size_t i = 0; i < m->positions.size(); ++i) {
+    const geom::Vec3& x = m->positions[i];
+    for (const plc::FeaturePoint& p : c->points) {
+      if (p.crease && p.p == x) brute[i] = 1;
+    }
+    for (const plc::FeatureSegment& s : c->segments) {
+      if (brute[i] || !s.crease) continue;
+      const geom::Vec3 a = c->points[s.a].p, d = c->points[s.b].p - a;
+      const double t = geom::Dot(x - a, d) / geom::Dot(d, d);
+      if (t > 0 && t < 1 && geom::Dist(a + t * d, x) <= 1e-12 * std::sqrt(geom::Dot(d, d))) {
+        brute[i] = 1;
+        ++on_segments;
+      }
+    }
+  }
+  std::printf("crease_pair_30: %zu vertices on crease segments (ends excluded)\n", on_segments);
+  EXPECT_GT(on_segments, 0u);
+  EXPECT_EQ(mesh::CreaseVertexFlags(*plc, *m), brute);
+}
+
 }  // namespace
 }  // namespace svrc
