@@ -11,6 +11,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/delaunay/point_set.h"
+#include "core/geometry/constructions.h"
 #include "core/geometry/predicates.h"
 #include "core/mesh/conformity.h"
 #include "core/mesh/stats_payload.h"
@@ -166,6 +167,37 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
   }
   if (params.max_vertices != 0) budget = std::min<uint64_t>(budget, params.max_vertices);
   return budget;
+}
+
+// The largest radius-edge ratio (circumradius over shortest edge) among the
+// kept tets of a refinement that touch no crease vertex (a crease point, or a
+// vertex of a crease segment's chain); 0 if the labelling is not known
+// (PointSetRefinement::tet_outside empty) or no such tet is kept.
+double WorstRadiusEdgeAwayFromCreases(const refine::PointSetRefinement& refined, const plc::FeatureComplex& complex) {
+  if (refined.tet_outside.size() != refined.tets.size()) return 0;
+  std::vector<uint8_t> crease(refined.normalised_positions.size(), 0);
+  for (uint32_t i = 0; i < complex.points.size(); ++i) {
+    if (complex.points[i].crease) crease[i] = 1;  // refiner point i = complex point i
+  }
+  for (uint32_t s = 0; s < complex.segments.size(); ++s) {
+    if (!complex.segments[s].crease) continue;
+    for (uint32_t v : refined.segment_chains[s]) crease[v] = 1;
+  }
+  double worst = 0;
+  for (size_t t = 0; t < refined.tets.size(); ++t) {
+    if (refined.tet_outside[t]) continue;
+    const std::array<uint32_t, 4>& q = refined.tets[t];
+    if (crease[q[0]] || crease[q[1]] || crease[q[2]] || crease[q[3]]) continue;
+    std::array<geom::Vec3, 4> p;
+    for (int k = 0; k < 4; ++k) p[k] = refined.normalised_positions[q[k]];
+    double l2 = HUGE_VAL;
+    for (int a = 0; a < 4; ++a) {
+      for (int b = a + 1; b < 4; ++b) l2 = std::min(l2, geom::Dist2(p[a], p[b]));
+    }
+    const geom::Vec3 c = geom::TetCircumcenter(p[0], p[1], p[2], p[3]);
+    worst = std::max(worst, std::sqrt(geom::Dist2(c, p[0]) / l2));
+  }
+  return worst;
 }
 
 }  // namespace
@@ -448,11 +480,21 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   // by a plane meeting two of its faces at 46°–51° ended FAILED_PRECONDITION
   // at 20,056 vertices before session 36 (docs/svrc-collars.md "Session 36").
   // Not when the caller's own max_vertices was the budget.
+  // Likewise when it ends with a tet away from the creases above the
+  // radius-edge bound: hull_41 of the random sweep (a 61.7° crease ending in
+  // a narrow corner) crowded 501 vertices within 1e-9 of the corner and left
+  // a tet of edge 1.3e-13 and radius-edge 3.36 touching no crease vertex.
   uint64_t mild_budget = 0;
-  if (!refined.ok() && !crease.empty() && !use_collars &&
-      refined.status().code() == absl::StatusCode::kResourceExhausted &&
-      (params.max_vertices == 0 || options.max_vertices < params.max_vertices)) {
-    mild_budget = options.max_vertices;
+  double mild_worst = 0;
+  if (refined.ok() && !crease.empty() && !use_collars) {
+    const double worst = WorstRadiusEdgeAwayFromCreases(*refined, *complex);
+    if (worst > params.radius_edge * (1 + 1e-9)) mild_worst = worst;
+  }
+  const bool overran = !refined.ok() && !crease.empty() && !use_collars &&
+                       refined.status().code() == absl::StatusCode::kResourceExhausted &&
+                       (params.max_vertices == 0 || options.max_vertices < params.max_vertices);
+  if (overran || mild_worst > 0) {
+    if (overran) mild_budget = options.max_vertices;
     use_collars = true;
     set_collar_options();
     rerun = true;
@@ -503,7 +545,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   if (refined->tet_outside.size() == refined->tets.size()) sliver.skip_tet = refined->tet_outside;
   sliver.keep_max_volume = params.max_volume > 0 || std::any_of(plc.regions.begin(), plc.regions.end(),
                                                                  [](const plc::RegionSeed& r) { return r.max_volume > 0; });
-  if (use_collars) {
+  // Crease vertices on either path: a flip may relax the radius-edge bound
+  // only for new tets touching a crease.
+  if (!crease.empty()) {
     sliver.crease_vertex.assign(refined->normalised_positions.size(), 0);
     for (uint32_t s = 0; s < complex->segments.size(); ++s) {
       if (!complex->segments[s].crease) continue;
@@ -616,6 +660,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   // The mild creases' vertex budget the run without collars overran before
   // it took collars (0: no fallback).
   mesh.stats.Set("mild_crease_budget_overrun", static_cast<double>(mild_budget));
+  // ... or the radius-edge ratio away from the creases it left (0: none).
+  mesh.stats.Set("mild_crease_radius_edge_over", mild_worst);
   mesh.stats.Set("seconds_validate", seconds_validate);
   mesh.stats.Set("seconds_refine", seconds_refine);
   mesh.stats.Set("seconds_total", elapsed());

@@ -977,5 +977,49 @@ TEST(CreaseMesh, CreaseVertexFlagsMatchTheGeometricTest) {
   EXPECT_EQ(mesh::CreaseVertexFlags(*plc, *m), brute);
 }
 
+// The convex hull of six random points (session 36's random "hull" family,
+// seed 41): creases of 61.7°, 76.4° and 87.8°, all mild, so it is refined
+// through without collars first. That run ended without error but crowded 501
+// vertices within 1e-9 of the corner where the 61.7° crease ends, and its
+// output held tets touching no crease vertex with radius-edge up to 4.6 (one
+// of edge 1.3e-13). Such a run now starts again with collars, like a budget
+// overrun (stat mild_crease_radius_edge_over).
+constexpr char kHullWithANarrowCorner[] = R"(6 3 0 0
+1 0.7631849238079367 0.25937323431229586 0.8659816375974134
+2 0.6476108914525136 0.9268467397938543 0.6584082983982552
+3 0.09661206348438633 0.3109797385080114 0.42338030866805354
+4 0.8982266898251746 0.6667385822602349 0.03634811245579306
+5 0.5077144575220912 0.4657505872218384 0.9713197087497489
+6 0.18442207734941118 0.20077629905378058 0.4093441500724766
+8 1
+1 0 1
+3 1 4 2
+1 0 1
+3 2 4 3
+1 0 1
+3 1 2 5
+1 0 1
+3 2 3 5
+1 0 1
+3 3 4 6
+1 0 1
+3 4 1 6
+1 0 1
+3 1 5 6
+1 0 1
+3 5 3 6
+0
+0
+)";
+
+TEST(CreaseMesh, MildCreasesLeavingBadTetsTakeCollars) {
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kHullWithANarrowCorner, plc::InputFormat::kPoly, "hull_41.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  const CreaseMeshed out = MeshAndCheck(*plc, "hull with a narrow corner");
+  EXPECT_GT(out.stats.Get("mild_crease_radius_edge_over"), 4.0);
+  EXPECT_EQ(out.stats.Get("mild_crease_budget_overrun"), 0);
+  EXPECT_GT(out.stats.Get("svrc.collars"), 0);
+}
+
 }  // namespace
 }  // namespace svrc
