@@ -3079,6 +3079,9 @@ absl::Status Refiner::StitchImpl() {
     if (f.kind == StitchFailure::Kind::kBookDegenerate || f.kind == StitchFailure::Kind::kBookFlat) {
       stitch_failures_.push_back({f.where, ball, 1});
     }
+    // Folded books: `where` is the crease circle's point nearest the fold's
+    // T′ vertex; inserting it splits the fold.
+    if (f.kind == StitchFailure::Kind::kBookFold) stitch_failures_.push_back({f.where, ball, 1});
   }
   if (!r.ok()) return r.status();
   // The tets to point ids in place, then moved: stitched_ grown by push_back

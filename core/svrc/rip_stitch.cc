@@ -33,6 +33,7 @@ const char* StitchFailureKindName(Kind kind) {
     case Kind::kBookDegenerate: return "book_degenerate";
     case Kind::kBookFlat: return "book_flat";
     case Kind::kFaceMismatch: return "face_mismatch";
+    case Kind::kBookFold: return "book_fold";
     case Kind::kVertexOutsideCollars: return "vertex_outside_collars";
     case Kind::kCreaseVertexUnused: return "crease_vertex_unused";
     case Kind::kCreaseEdgeMissing: return "crease_edge_missing";
@@ -592,6 +593,32 @@ absl::StatusOr<StitchResult> RipStitchCollar(const StitchInput& in,
         const bool pt = p.src & kTPrime, qt = q.src & kTPrime;
         if (!pt && !qt) ok = p.side != q.side;           // interior face
         if (pt != qt) ok = p.side == q.side;             // T′ face matched once
+      }
+      // Two books of one crease edge vw over circle edges ab and ac on the
+      // same side of their face (v, w, a): the restricted edges fold back
+      // around the axis at a (hull seed 60 of session 36's sweep: circle
+      // edges 8716-27209 and 27209-37289 of one ball pair). The circle's
+      // point nearest a is a point of S that splits the fold.
+      if (!ok && r1 - r0 == 2 && !(recs[r0].src & kTPrime) && !(recs[r0 + 1].src & kTPrime) &&
+          recs[r0].src >= faces.size() && recs[r0 + 1].src >= faces.size() && recs[r0].side == recs[r0 + 1].side) {
+        const Book& b0 = books[recs[r0].src - faces.size()];
+        const Book& b1 = books[recs[r0 + 1].src - faces.size()];
+        if (b0.pair == b1.pair) {
+          const CreasePair& cp = pairs[b0.pair];
+          uint32_t a = kNone;
+          for (uint32_t v : recs[r0].key) {
+            if (v != b0.tet[0] && v != b0.tet[1]) a = v;
+          }
+          Vec3 x;
+          if (a != kNone && NearestCirclePoint(cp.circle, P(a), &x)) {
+            fail(Kind::kBookFold, x, cp.i,
+                 absl::StrCat("books (", b0.tet[0], ", ", b0.tet[1], ", ", b0.tet[2], ", ", b0.tet[3], ") and (",
+                              b1.tet[0], ", ", b1.tet[1], ", ", b1.tet[2], ", ", b1.tet[3],
+                              ") of one crease edge are on the same side of their shared face"));
+            r0 = r1;
+            continue;
+          }
+        }
       }
       if (!ok) {
         const auto& k = recs[r0].key;

@@ -79,6 +79,7 @@ struct StitchFailure {
     kVertexOutsideCollars,   // a vertex only on inside tets is not strictly inside a ball
     kCreaseVertexUnused,     // a crease vertex in no stitched tet
     kCreaseEdgeMissing,      // crossing crease edge vw got no book
+    kBookFold,               // two books of one crease edge on the same side of their shared face
   };
   Kind kind;
   Vec3 where;

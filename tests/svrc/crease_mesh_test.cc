@@ -1021,5 +1021,66 @@ TEST(CreaseMesh, MildCreasesLeavingBadTetsTakeCollars) {
   EXPECT_GT(out.stats.Get("svrc.collars"), 0);
 }
 
+// The convex hull of nine random points squashed into a slab 0.07 thick
+// (session 36's random "hull" family, seed 60; 450 collars). The restricted
+// edges of one crease circle folded back: books (526, 6673, 27209, 8716) and
+// (526, 6673, 27209, 37289) lay on the same side of their shared face, and
+// the run ended FAILED_PRECONDITION "RipStitchCollar: 4 failure(s); first:
+// face_mismatch". The stitch now names such a pair book_fold with the circle's
+// point nearest the fold's vertex, and the refiner inserts it as it does for
+// a flat book (~25 s).
+constexpr char kSquashedHull[] = R"(9 3 0 0
+1 0.1874130137535741 0.0337322747653215 0.07583463756480968
+2 0.7804062209001514 0.03924255802777107 0.29331255891941455
+3 0.030270557168226353 0.02223485493143471 0.47474616005997927
+4 0.020556979011820853 0.014107430892075848 0.8977560971879309
+5 0.9253310430273469 0.041100649436582794 0.43832507678025934
+6 0.47582309016191116 0.008331683257761251 0.024610345667546274
+7 0.8370645042366188 0.07267980011291811 0.5492732451483241
+8 0.9071556459054583 0.0035499078845693875 0.598378592111725
+9 0.3063945886108155 0.0531840790349285 0.9596017381966057
+14 1
+1 0 1
+3 1 2 6
+1 0 1
+3 3 1 6
+1 0 1
+3 4 3 6
+1 0 1
+3 2 5 6
+1 0 1
+3 2 1 7
+1 0 1
+3 5 2 7
+1 0 1
+3 4 6 8
+1 0 1
+3 6 5 8
+1 0 1
+3 5 7 8
+1 0 1
+3 1 3 9
+1 0 1
+3 7 1 9
+1 0 1
+3 3 4 9
+1 0 1
+3 4 8 9
+1 0 1
+3 8 7 9
+0
+0
+)";
+
+TEST(CreaseMesh, FoldedBooksAreRepaired) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kSquashedHull, plc::InputFormat::kPoly, "hull_60.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  const CreaseMeshed out = MeshAndCheck(*plc, "squashed hull");
+  EXPECT_GT(out.stats.Get("svrc.collars"), 400);
+}
+
 }  // namespace
 }  // namespace svrc
