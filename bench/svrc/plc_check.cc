@@ -26,15 +26,6 @@ namespace {
 
 using namespace svrc;
 
-double MaxTetVolume(const mesh::TetMesh& m) {
-  double vmax = 0;
-  for (const auto& t : m.tets) {
-    const geom::Vec3 a = m.positions[t[0]];
-    vmax = std::max(vmax, geom::Dot(m.positions[t[1]] - a, geom::Cross(m.positions[t[2]] - a, m.positions[t[3]] - a)) / 6);
-  }
-  return vmax;
-}
-
 int Usage() {
   std::fprintf(stderr, "usage: svrc_plc_check IN [--radius-edge R] [--max-volume V] [--keep-bounding-box]\n");
   return 1;
@@ -69,8 +60,8 @@ int main(int argc, char** argv) {
   mesh::ConformityOptions o;
   o.keep_bounding_box = p.keep_bounding_box;
   const mesh::ConformityReport rep = mesh::CheckConformity(*plc, *m, o);
-  const double vmax = MaxTetVolume(*m);
   const mesh::QualityReport q = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(*plc, *m));
+  const double vmax = q.all.max_volume;
   const mesh::MeshStats& st = m->stats;
   const bool collars = st.Get("svrc.collars") > 0;
   const double stitched = std::max(st.Get("svrc.max_bounded_dihedral_deg"), st.Get("svrc.max_unbounded_dihedral_deg"));

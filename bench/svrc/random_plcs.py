@@ -65,15 +65,19 @@ def gen_pts(rng):
             nodes.append(tuple(q))
     return nodes, box_facets()
 
-def gen_segs(rng):
-    nodes = list(BOX)
-    facets = box_facets()
-    for _ in range(rng.randint(1, 5)):
+def add_free_segments_and_points(rng, nodes, facets, segments, points):
+    """rng.randint(*segments) free segments (marker 2), then rng.randint(*points) isolated points."""
+    for _ in range(rng.randint(*segments)):
         a = rnd_interior(rng); b = rnd_interior(rng)
         nodes += [a, b]
         facets.append(([[len(nodes)-2, len(nodes)-1]], 2))
-    for _ in range(rng.randint(0, 5)):
+    for _ in range(rng.randint(*points)):
         nodes.append(rnd_interior(rng))
+
+def gen_segs(rng):
+    nodes = list(BOX)
+    facets = box_facets()
+    add_free_segments_and_points(rng, nodes, facets, (1, 5), (0, 5))
     return nodes, facets
 
 def plane_basis(n):
@@ -174,12 +178,7 @@ def gen_mixed(rng):
     if r is None:
         return None
     nodes, facets = r
-    for _ in range(rng.randint(0, 2)):
-        a = rnd_interior(rng); b = rnd_interior(rng)
-        nodes += [a, b]
-        facets.append(([[len(nodes)-2, len(nodes)-1]], 2))
-    for _ in range(rng.randint(0, 4)):
-        nodes.append(rnd_interior(rng))
+    add_free_segments_and_points(rng, nodes, facets, (0, 2), (0, 4))
     return nodes, facets
 
 GENS = dict(pts=gen_pts, segs=gen_segs, float=gen_float, cut=gen_cut, tet=gen_tet, mixed=gen_mixed)

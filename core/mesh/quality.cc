@@ -101,9 +101,11 @@ Distribution Distribution::Of(std::vector<double> values) {
 QualityReport ComputeQuality(const TetMesh& mesh, const std::vector<uint8_t>& crease_vertex) {
   struct Acc {
     std::vector<double> re, dih, min_dih, aspect;
+    double max_volume = -HUGE_VAL;
     QualityGroup Finish() {
       QualityGroup g;
       g.num_tets = re.size();
+      g.max_volume = re.empty() ? 0 : max_volume;
       g.radius_edge = Distribution::Of(std::move(re));
       g.dihedral_deg = Distribution::Of(std::move(dih));
       g.min_dihedral_deg = Distribution::Of(std::move(min_dih));
@@ -124,6 +126,7 @@ QualityReport ComputeQuality(const TetMesh& mesh, const std::vector<uint8_t>& cr
       acc->dih.insert(acc->dih.end(), q.dihedral_deg.begin(), q.dihedral_deg.end());
       acc->min_dih.push_back(q.min_dihedral_deg);
       acc->aspect.push_back(q.aspect);
+      acc->max_volume = std::max(acc->max_volume, q.volume);
     }
   }
   QualityReport r;

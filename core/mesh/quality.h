@@ -42,6 +42,7 @@ struct QualityGroup {
   Distribution dihedral_deg;  // all six angles of every tet of the group
   Distribution min_dihedral_deg;  // per tet
   Distribution aspect;
+  double max_volume = 0;  // the largest TetQuality::volume of the group (signed; 0 if empty)
 };
 
 struct QualityReport {

@@ -128,6 +128,13 @@ TEST(QualityReport, SplitsByCreaseVertex) {
   EXPECT_NEAR(r.other.min_dihedral_deg.min, 70.5288, 1e-4);
   EXPECT_LT(r.crease.min_dihedral_deg.min, 0.2);
   EXPECT_EQ(r.all.dihedral_deg.count, 12u);
+  // The largest volume per group (svrc_plc_check's max_volume test).
+  const double reg = ComputeTetQuality(m.positions[0], m.positions[1], m.positions[2], m.positions[3]).volume;
+  const double sliver = ComputeTetQuality(m.positions[4], m.positions[5], m.positions[6], m.positions[7]).volume;
+  EXPECT_GT(reg, sliver);
+  EXPECT_EQ(r.other.max_volume, reg);
+  EXPECT_EQ(r.crease.max_volume, sliver);
+  EXPECT_EQ(r.all.max_volume, reg);
   const std::string text = FormatQualityReport(r);
   EXPECT_NE(text.find("touching a crease: 1 tets"), std::string::npos) << text;
   EXPECT_NE(text.find("radius-edge"), std::string::npos);

@@ -91,6 +91,17 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what, const co
   return out;
 }
 
+// MeshAndCheck on a .poly file's text held by the test (`name` names it in
+// messages).
+CreaseMeshed MeshPolyTextAndCheck(const char* poly, const char* name, const std::string& what) {
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(poly, plc::InputFormat::kPoly, name);
+  if (!plc.ok()) {
+    ADD_FAILURE() << name << ": " << plc.status();
+    return {};
+  }
+  return MeshAndCheck(*plc, what);
+}
+
 // MeshAndCheck on a corpus file (path relative to the corpus).
 CreaseMeshed MeshCorpusFileAndCheck(const std::string& path) {
   absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(path));
@@ -938,9 +949,7 @@ constexpr char kFloatingTriangles[] = R"(17 3 0 0
 )";
 
 TEST(CreaseMesh, SliverFlipsKeepTheStitchedDihedralsAtFloatingCorners) {
-  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kFloatingTriangles, plc::InputFormat::kPoly, "float_4.poly");
-  ASSERT_TRUE(plc.ok()) << plc.status();
-  const CreaseMeshed out = MeshAndCheck(*plc, "three floating triangles");
+  const CreaseMeshed out = MeshPolyTextAndCheck(kFloatingTriangles, "float_4.poly", "three floating triangles");
   EXPECT_EQ(out.stats.Get("svrc.vertex_collars"), 7);
   EXPECT_GT(out.stats.Get("sliver.rejected_crease_angle"), 0);
 }
@@ -1013,9 +1022,7 @@ constexpr char kHullWithANarrowCorner[] = R"(6 3 0 0
 )";
 
 TEST(CreaseMesh, MildCreasesLeavingBadTetsTakeCollars) {
-  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kHullWithANarrowCorner, plc::InputFormat::kPoly, "hull_41.poly");
-  ASSERT_TRUE(plc.ok()) << plc.status();
-  const CreaseMeshed out = MeshAndCheck(*plc, "hull with a narrow corner");
+  const CreaseMeshed out = MeshPolyTextAndCheck(kHullWithANarrowCorner, "hull_41.poly", "hull with a narrow corner");
   EXPECT_GT(out.stats.Get("mild_crease_radius_edge_over"), 4.0);
   EXPECT_EQ(out.stats.Get("mild_crease_budget_overrun"), 0);
   EXPECT_GT(out.stats.Get("svrc.collars"), 0);
@@ -1076,9 +1083,7 @@ TEST(CreaseMesh, FoldedBooksAreRepaired) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "release only";
 #endif
-  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kSquashedHull, plc::InputFormat::kPoly, "hull_60.poly");
-  ASSERT_TRUE(plc.ok()) << plc.status();
-  const CreaseMeshed out = MeshAndCheck(*plc, "squashed hull");
+  const CreaseMeshed out = MeshPolyTextAndCheck(kSquashedHull, "hull_60.poly", "squashed hull");
   EXPECT_GT(out.stats.Get("svrc.collars"), 400);
 }
 
