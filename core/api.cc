@@ -101,7 +101,7 @@ absl::StatusOr<mesh::TetMesh> MeshPointSet(const plc::Plc& plc, const ProgressCa
 constexpr double kCollarAngleDeg = 45;
 
 // The phase of the second refinement when one without collars overran its
-// budget (Progress::phase).
+// budget or left a tet away from the creases above the bound (Progress::phase).
 constexpr const char* kRefineCollarsPhase = "refine-collars";
 
 // The first crease of the complex, as "crease at segment (a, b): features meet
@@ -499,6 +499,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
     set_collar_options();
     rerun = true;
     report(kRefineCollarsPhase, 0, 0, 0);
+    refined = absl::AbortedError("superseded by the run with collars");  // frees the first run's mesh first
     refined = refine::RefinePlc(*complex, options);
   }
   if (!refined.ok()) {
