@@ -486,6 +486,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   // a tet of edge 1.3e-13 and radius-edge 3.36 touching no crease vertex.
   uint64_t mild_budget = 0;
   double mild_worst = 0;
+  bool mild_failed = false;
   if (refined.ok() && !crease.empty() && !use_collars) {
     const double worst = WorstRadiusEdgeAwayFromCreases(*refined, *complex);
     if (worst > params.radius_edge * (1 + 1e-9)) mild_worst = worst;
@@ -493,8 +494,16 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   const bool overran = !refined.ok() && !crease.empty() && !use_collars &&
                        refined.status().code() == absl::StatusCode::kResourceExhausted &&
                        (params.max_vertices == 0 || options.max_vertices < params.max_vertices);
-  if (overran || mild_worst > 0) {
+  // And when it stops at the resolution of doubles: hull_158 of the sweep
+  // crowded a crease corner until two points of one segment rounded to the
+  // same place (INTERNAL "point 13275 could not be inserted into facet mesh
+  // 2 (coincides with point 12659 ...)").
+  const bool mild_error = !refined.ok() && !crease.empty() && !use_collars &&
+                          (refined.status().code() == absl::StatusCode::kInternal ||
+                           refined.status().code() == absl::StatusCode::kFailedPrecondition);
+  if (overran || mild_worst > 0 || mild_error) {
     if (overran) mild_budget = options.max_vertices;
+    mild_failed = mild_error;
     use_collars = true;
     set_collar_options();
     rerun = true;
@@ -663,6 +672,8 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   mesh.stats.Set("mild_crease_budget_overrun", static_cast<double>(mild_budget));
   // ... or the radius-edge ratio away from the creases it left (0: none).
   mesh.stats.Set("mild_crease_radius_edge_over", mild_worst);
+  // ... or whether it ended with an error (1).
+  mesh.stats.Set("mild_crease_error", mild_failed ? 1 : 0);
   mesh.stats.Set("seconds_validate", seconds_validate);
   mesh.stats.Set("seconds_refine", seconds_refine);
   mesh.stats.Set("seconds_total", elapsed());

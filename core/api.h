@@ -57,8 +57,9 @@ struct MeshParams {
 struct Progress {
   // "validate", "refine", with creases "collar", "stitch", "stitch-repair"
   // (refine::refine_phase), then "assemble", "check", "done". Mild creases
-  // (45°–90°) whose refinement without collars overruns its budget or leaves
-  // a tet away from the creases above the bound start again with collars:
+  // (45°–90°) whose refinement without collars overruns its budget, ends with
+  // an error or leaves a tet away from the creases above the bound start
+  // again with collars:
   // "refine-collars", then "collar" and on.
   std::string phase;
   uint64_t vertices = 0;             // vertices in the output mesh so far

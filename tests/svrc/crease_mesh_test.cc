@@ -1087,5 +1087,55 @@ TEST(CreaseMesh, FoldedBooksAreRepaired) {
   EXPECT_GT(out.stats.Get("svrc.collars"), 400);
 }
 
+// The convex hull of random points (session 36's random "hull" family, seed
+// 158; seven mild creases). Its mild-path run crowded a crease corner until
+// two points of one segment rounded to the same place and ended INTERNAL
+// "point 13275 could not be inserted into facet mesh 2 (coincides with point
+// 12659; CD 1,3 and 1,3, parents 13 and 13)". A mild-path run that ends with
+// an error (INTERNAL or FAILED_PRECONDITION) now starts again with collars
+// (stat mild_crease_error).
+constexpr char kHullStoppedAtTheResolutionOfDoubles[] = R"(7 3 0 0
+1 0.5342139257873884 0.24436839486240824 0.9792274325986476
+2 0.22054940392043698 0.7962977595963613 0.27369875064221805
+3 0.4699597515913123 0.547979071093485 0.8209338709687669
+4 0.6199395271357776 0.30655239302708015 0.35222354577358506
+5 0.7063499076424989 0.27101040064099213 0.7772076591738553
+6 0.05972826985981594 0.08791419465087569 0.4089156981287776
+7 0.7148765161810714 0.15689649197663402 0.29424357688399827
+10 1
+1 0 1
+3 3 1 5
+1 0 1
+3 2 3 5
+1 0 1
+3 4 2 5
+1 0 1
+3 1 3 6
+1 0 1
+3 3 2 6
+1 0 1
+3 2 4 7
+1 0 1
+3 6 2 7
+1 0 1
+3 4 5 7
+1 0 1
+3 5 1 7
+1 0 1
+3 1 6 7
+0
+0
+)";
+
+TEST(CreaseMesh, MildCreasesEndingInAnErrorTakeCollars) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  const CreaseMeshed out =
+      MeshPolyTextAndCheck(kHullStoppedAtTheResolutionOfDoubles, "hull_158.poly", "hull stopped at doubles");
+  EXPECT_EQ(out.stats.Get("mild_crease_error"), 1);
+  EXPECT_GT(out.stats.Get("svrc.collars"), 0);
+}
+
 }  // namespace
 }  // namespace svrc
