@@ -11,9 +11,9 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/delaunay/point_set.h"
-#include "core/geometry/constructions.h"
 #include "core/geometry/predicates.h"
 #include "core/mesh/conformity.h"
+#include "core/mesh/quality.h"
 #include "core/mesh/stats_payload.h"
 #include "core/mesh/writers.h"
 #include "core/plc/validate.h"
@@ -169,33 +169,34 @@ uint64_t CreaseBudget(const plc::FeatureComplex& complex, const MeshParams& para
   return budget;
 }
 
-// The largest radius-edge ratio (circumradius over shortest edge) among the
-// kept tets of a refinement that touch no crease vertex (a crease point, or a
-// vertex of a crease segment's chain); 0 if the labelling is not known
-// (PointSetRefinement::tet_outside empty) or no such tet is kept.
-double WorstRadiusEdgeAwayFromCreases(const refine::PointSetRefinement& refined, const plc::FeatureComplex& complex) {
-  if (refined.tet_outside.size() != refined.tets.size()) return 0;
+// One flag per refiner vertex: a crease point (refiner point i = complex
+// point i) or a vertex of a crease segment's chain.
+std::vector<uint8_t> CreaseVerticesOf(const refine::PointSetRefinement& refined, const plc::FeatureComplex& complex) {
   std::vector<uint8_t> crease(refined.normalised_positions.size(), 0);
   for (uint32_t i = 0; i < complex.points.size(); ++i) {
-    if (complex.points[i].crease) crease[i] = 1;  // refiner point i = complex point i
+    if (complex.points[i].crease) crease[i] = 1;
   }
   for (uint32_t s = 0; s < complex.segments.size(); ++s) {
     if (!complex.segments[s].crease) continue;
     for (uint32_t v : refined.segment_chains[s]) crease[v] = 1;
   }
+  return crease;
+}
+
+// The largest radius-edge ratio (mesh::ComputeTetQuality's, the checkers')
+// among the kept tets of a refinement that touch no crease vertex
+// (CreaseVerticesOf); 0 if the labelling is not known
+// (PointSetRefinement::tet_outside empty) or no such tet is kept.
+double WorstRadiusEdgeAwayFromCreases(const refine::PointSetRefinement& refined, const plc::FeatureComplex& complex) {
+  if (refined.tet_outside.size() != refined.tets.size()) return 0;
+  const std::vector<uint8_t> crease = CreaseVerticesOf(refined, complex);
+  const std::vector<geom::Vec3>& p = refined.normalised_positions;
   double worst = 0;
   for (size_t t = 0; t < refined.tets.size(); ++t) {
     if (refined.tet_outside[t]) continue;
     const std::array<uint32_t, 4>& q = refined.tets[t];
     if (crease[q[0]] || crease[q[1]] || crease[q[2]] || crease[q[3]]) continue;
-    std::array<geom::Vec3, 4> p;
-    for (int k = 0; k < 4; ++k) p[k] = refined.normalised_positions[q[k]];
-    double l2 = HUGE_VAL;
-    for (int a = 0; a < 4; ++a) {
-      for (int b = a + 1; b < 4; ++b) l2 = std::min(l2, geom::Dist2(p[a], p[b]));
-    }
-    const geom::Vec3 c = geom::TetCircumcenter(p[0], p[1], p[2], p[3]);
-    worst = std::max(worst, std::sqrt(geom::Dist2(c, p[0]) / l2));
+    worst = std::max(worst, mesh::ComputeTetQuality(p[q[0]], p[q[1]], p[q[2]], p[q[3]]).radius_edge);
   }
   return worst;
 }
@@ -557,16 +558,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
                                                                  [](const plc::RegionSeed& r) { return r.max_volume > 0; });
   // Crease vertices on either path: a flip may relax the radius-edge bound
   // only for new tets touching a crease.
-  if (!crease.empty()) {
-    sliver.crease_vertex.assign(refined->normalised_positions.size(), 0);
-    for (uint32_t s = 0; s < complex->segments.size(); ++s) {
-      if (!complex->segments[s].crease) continue;
-      for (uint32_t p : refined->segment_chains[s]) sliver.crease_vertex[p] = 1;
-    }
-    for (uint32_t i = 0; i < complex->points.size(); ++i) {
-      if (complex->points[i].crease) sliver.crease_vertex[i] = 1;  // refiner point i = complex point i
-    }
-  }
+  if (!crease.empty()) sliver.crease_vertex = CreaseVerticesOf(*refined, *complex);
   // SVRC_DUMP_NONCONFORMING (debugging aid, below): the tets before the flips.
   const char* dump_env = std::getenv("SVRC_DUMP_NONCONFORMING");
   const bool dumping = dump_env != nullptr && *dump_env != '\0';
