@@ -6,10 +6,12 @@
 // radius-edge within the bound on every tet not touching a crease, and on the
 // collar path the stitch's own guarantees (tets next to creases within the
 // largest stitched dihedral; star and book σ within 60° unless the snap band
-// was used). Prints one line: OK / BAD (with the failed checks named) /
+// was used), each region's own max volume, the attribute of the region around
+// each region seed, and no tet around a volume hole point. Prints one line: OK / BAD (with the failed checks named) /
 // FAIL (the mesher's error) / READ (the reader's). Exit 0 OK, 3 BAD, 2 FAIL,
 // 1 READ or usage. bench/svrc/random_sweep.sh runs it over random PLCs.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -25,6 +27,30 @@
 namespace {
 
 using namespace svrc;
+using geom::Vec3;
+
+double Det3(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double ax = a.x - d.x, ay = a.y - d.y, az = a.z - d.z;
+  const double bx = b.x - d.x, by = b.y - d.y, bz = b.z - d.z;
+  const double cx = c.x - d.x, cy = c.y - d.y, cz = c.z - d.z;
+  return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
+}
+
+// The tets whose closure holds p (floating point; seeds sit well inside).
+std::vector<size_t> TetsAround(const mesh::TetMesh& m, const Vec3& p) {
+  std::vector<size_t> out;
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    const auto& k = m.tets[t];
+    const Vec3& a = m.positions[k[0]];
+    const Vec3& b = m.positions[k[1]];
+    const Vec3& c = m.positions[k[2]];
+    const Vec3& d = m.positions[k[3]];
+    if (Det3(p, b, c, d) >= 0 && Det3(a, p, c, d) >= 0 && Det3(a, b, p, d) >= 0 && Det3(a, b, c, p) >= 0) {
+      out.push_back(t);
+    }
+  }
+  return out;
+}
 
 int Usage() {
   std::fprintf(stderr, "usage: svrc_plc_check IN [--radius-edge R] [--max-volume V] [--keep-bounding-box]\n");
@@ -70,14 +96,35 @@ int main(int argc, char** argv) {
   const bool dih_ok = !collars || q.crease.dihedral_deg.max <= stitched + 1e-6;
   const bool sigma_ok = !collars || st.Get("svrc.collar_snap") > 0 ||
                         (st.Get("svrc.star_sigma_max_deg") <= 60 + 1e-9 && st.Get("svrc.book_sigma_max_deg") <= 60 + 1e-9);
-  const bool ok = rep.ok() && vol_ok && re_ok && dih_ok && sigma_ok;
+  // Each region's own bound, and the regions the seeds name.
+  bool region_ok = true;
+  for (size_t t = 0; t < m->tets.size() && region_ok; ++t) {
+    const double rv = m->regions[m->tet_region[t]].max_volume;
+    if (rv <= 0) continue;
+    const auto& k = m->tets[t];
+    const double v = Det3(m->positions[k[0]], m->positions[k[1]], m->positions[k[2]], m->positions[k[3]]) / 6;
+    if (std::abs(v) > rv * (1 + 1e-9)) region_ok = false;
+  }
+  bool seeds_ok = true;
+  for (const plc::RegionSeed& r : plc->regions) {
+    for (size_t t : TetsAround(*m, r.point)) {
+      if (m->regions[m->tet_region[t]].attribute != r.attribute) seeds_ok = false;
+    }
+  }
+  if (!p.keep_bounding_box) {
+    for (const Vec3& h : plc->holes) {
+      if (!TetsAround(*m, h).empty()) seeds_ok = false;
+    }
+  }
+  const bool ok = rep.ok() && vol_ok && re_ok && dih_ok && sigma_ok && region_ok && seeds_ok;
   std::printf(
       "%s tets %zu conform %s vmax %.4g%s re_other %.4g%s dih_other %.3g..%.4g crease_tets %zu crease_dih_max %.2f "
-      "stitched %.2f%s collars %g snap %g star_sigma %.1f%s mild_overrun %g\n",
+      "stitched %.2f%s collars %g snap %g star_sigma %.1f%s mild_overrun %g regions %zu%s%s\n",
       ok ? "OK" : "BAD", m->tets.size(), rep.ok() ? "yes" : rep.Summary().substr(0, 200).c_str(), vmax,
       vol_ok ? "" : " VOLUME_OVER", q.other.radius_edge.max, re_ok ? "" : " RADIUS_EDGE_OVER", q.other.dihedral_deg.min,
       q.other.dihedral_deg.max, q.crease.num_tets, q.crease.dihedral_deg.max, stitched, dih_ok ? "" : " DIHEDRAL_OVER",
       st.Get("svrc.collars"), st.Get("svrc.collar_snap"), st.Get("svrc.star_sigma_max_deg"), sigma_ok ? "" : " SIGMA_OVER",
-      st.Get("mild_crease_budget_overrun"));
+      st.Get("mild_crease_budget_overrun"), m->regions.size(), region_ok ? "" : " REGION_VOLUME_OVER",
+      seeds_ok ? "" : " SEED_REGION_WRONG");
   return ok ? 0 : 3;
 }

@@ -13,6 +13,10 @@ with repr, so they round-trip). Kinds (all inside or on the unit box):
   hull      the convex hull of 5-12 random points, 30% of them squashed
   segfacet  segments standing on the floor at 2-89 degrees
   near      features 1e-2..1e-7 from a wall or from each other
+  prism     a star-shaped (non-convex) polygon extruded, its own region
+            (attribute, sometimes a max volume), sometimes tilted or a hole
+  holed     floating star-shaped facets with a polygonal hole, and a
+            region bound on the box
 Some outputs are invalid PLCs (intersecting features); the sweep validates
 first and skips them.
 """
@@ -28,10 +32,14 @@ def write_poly(path, nodes, facets, holes=(), regions=()):
         for i, p in enumerate(nodes):
             f.write(f"{i+1} {p[0]!r} {p[1]!r} {p[2]!r}\n")
         f.write(f"{len(facets)} 1\n")
-        for polys, marker in facets:
-            f.write(f"{len(polys)} 0 {marker}\n")
+        for facet in facets:
+            polys, marker = facet[0], facet[1]
+            fholes = facet[2] if len(facet) > 2 else []
+            f.write(f"{len(polys)} {len(fholes)} {marker}\n")
             for poly in polys:
                 f.write(f"{len(poly)} " + " ".join(str(v+1) for v in poly) + "\n")
+            for i, h in enumerate(fholes):
+                f.write(f"{i+1} {h[0]!r} {h[1]!r} {h[2]!r}\n")
         f.write(f"{len(holes)}\n")
         for i, h in enumerate(holes):
             f.write(f"{i+1} {h[0]!r} {h[1]!r} {h[2]!r}\n")
@@ -282,6 +290,76 @@ def gen_near(rng):
     return nodes, facets
 
 GENS['near'] = gen_near
+
+def star_polygon(rng, c, n, rmin, rmax):
+    """n points around c (2D) at sorted random angles: a simple, star-shaped polygon."""
+    angs = sorted(rng.uniform(0, 2 * math.pi) for _ in range(n))
+    if any(b - a < 1e-3 for a, b in zip(angs, angs[1:] + [angs[0] + 2 * math.pi])):
+        return None
+    return [(c[0] + r * math.cos(a), c[1] + r * math.sin(a)) for a, r in ((a, rng.uniform(rmin, rmax)) for a in angs)]
+
+def gen_prism(rng):
+    """A star-shaped polygon extruded along z (reflex vertical edges: sharp
+    dihedral angles outside the prism), its inside a region of its own."""
+    n = rng.randint(4, 14)
+    c = (rng.uniform(0.4, 0.6), rng.uniform(0.4, 0.6))
+    poly = star_polygon(rng, c, n, 0.04, 0.35)
+    if poly is None:
+        return None
+    z0, z1 = rng.uniform(0.05, 0.45), rng.uniform(0.55, 0.95)
+    tilt = rng.random() < 0.3
+    a = math.radians(rng.uniform(-20, 20)) if tilt else 0.0
+    def place(x, y, z):  # a tilt about the x axis through the box centre
+        y2 = 0.5 + (y - 0.5) * math.cos(a) - (z - 0.5) * math.sin(a)
+        z2 = 0.5 + (y - 0.5) * math.sin(a) + (z - 0.5) * math.cos(a)
+        return (x, y2, z2)
+    nodes = list(BOX)
+    b = len(nodes)
+    nodes += [place(x, y, z0) for x, y in poly]
+    nodes += [place(x, y, z1) for x, y in poly]
+    if not all(0.01 < q[i] < 0.99 for q in nodes[b:] for i in range(3)):
+        return None
+    facets = box_facets()
+    facets.append(([list(reversed(range(b, b + n)))], 2))
+    facets.append(([list(range(b + n, b + 2 * n))], 2))
+    for i in range(n):
+        j = (i + 1) % n
+        facets.append(([[b + i, b + j, b + n + j, b + n + i]], 4))
+    mid = place(c[0], c[1], (z0 + z1) / 2)
+    regions = [(0.005, 0.005, 0.005, 1, 0.0), (mid[0], mid[1], mid[2], 2, rng.choice([0.0, 1e-3, 3e-4]))]
+    holes = []
+    if rng.random() < 0.2:  # the prism is a hole instead
+        regions = regions[:1]
+        holes = [mid]
+    return nodes, facets, holes, regions
+
+def gen_holed(rng):
+    """1-2 floating star-shaped facets, each with a star-shaped hole around its
+    centre (a facet hole point), at random orientations; the box is a region
+    with a max volume."""
+    nodes = list(BOX)
+    facets = box_facets()
+    k = rng.randint(1, 2)
+    for _ in range(k):
+        c3 = rnd_interior(rng, 0.35, 0.65)
+        nrm = [rng.gauss(0, 1) for _ in range(3)]; l = norm(nrm); nrm = tuple(x / l for x in nrm)
+        if rng.random() < 0.4:
+            nrm = (0.0, 0.0, 1.0)
+        u, v = plane_basis(nrm)
+        outer = star_polygon(rng, (0, 0), rng.randint(3, 9), 0.12, 0.3)
+        inner = star_polygon(rng, (0, 0), rng.randint(3, 7), 0.02, 0.1)
+        if outer is None or inner is None:
+            return None
+        def lift(p):
+            return tuple(c3[i] + p[0] * u[i] + p[1] * v[i] for i in range(3))
+        bo = len(nodes); nodes += [lift(p) for p in outer]
+        bi = len(nodes); nodes += [lift(p) for p in inner]
+        facets.append(([list(range(bo, bo + len(outer))), list(range(bi, bi + len(inner)))], 3, [c3]))
+    regions = [(0.5, 0.5, 0.01, 7, rng.choice([1e-3, 1e-2]))]
+    return nodes, facets, (), regions
+
+GENS['prism'] = gen_prism
+GENS['holed'] = gen_holed
 
 if __name__ == '__main__':
     kind, seed, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]

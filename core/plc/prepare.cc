@@ -850,17 +850,31 @@ class Preparer {
 
   void CheckIntersections() {
     // Primitives: triangles of usable facets, free segments on no facet.
+    // Segments of facets take part in the segment-segment test only: two
+    // edges of one facet's polygons that cross (a hole loop crossing its
+    // outer loop) are invisible to the triangle tests, which skip pairs of
+    // one facet, and the facet's triangulation may even succeed by leaving
+    // the crossing loop out of it (random_plcs.py holed 2).
     struct Prim {
       uint32_t facet;     // kNoId for a segment
       uint32_t index;     // triangle index or segment id
+      bool facet_segment = false;
     };
     std::vector<Prim> prims;
     for (uint32_t f = 0; f < fc_.facets.size(); ++f) {
       if (!work_[f].ok) continue;
       for (uint32_t t = 0; t < fc_.facets[f].triangles.size(); ++t) prims.push_back({f, t});
     }
+    // Only facets that triangulated with two or more loops can hide a
+    // crossing (a lone loop that crosses itself fails to triangulate).
+    auto several_loops = [&](FacetId f) { return work_[f].ok && fc_.facets[f].loops.size() >= 2; };
     for (SegmentId s = 0; s < fc_.segments.size(); ++s) {
-      if (fc_.segments[s].facets.empty()) prims.push_back({kNoId, s});
+      const std::vector<FacetId>& fs = fc_.segments[s].facets;
+      if (fs.empty()) {
+        prims.push_back({kNoId, s});
+      } else if (std::any_of(fs.begin(), fs.end(), several_loops)) {
+        prims.push_back({kNoId, s, true});
+      }
     }
     if (prims.size() < 2) return;
     BoxGrid grid(bounds_, prims.size());
@@ -875,9 +889,22 @@ class Preparer {
       }
     }
     std::set<std::pair<uint32_t, uint32_t>> ff, sf, ss;
+    std::set<uint32_t> crossed_facets;
     grid.ForEachOverlappingPair([&](uint32_t i, uint32_t j) {
       const Prim& a = prims[i];
       const Prim& b = prims[j];
+      if (a.facet_segment || b.facet_segment) {
+        if (a.facet != kNoId || b.facet != kNoId) return;  // a facet's segment and a triangle
+        if (!SegSegImproper(a.index, b.index)) return;
+        const std::vector<FacetId>& fa = fc_.segments[a.index].facets;
+        const std::vector<FacetId>& fb = fc_.segments[b.index].facets;
+        // Edges of two facets that cross make their triangles cross too
+        // (reported below); edges of one facet are this test's own finding.
+        for (FacetId f : fa) {
+          if (several_loops(f) && std::find(fb.begin(), fb.end(), f) != fb.end()) crossed_facets.insert(f);
+        }
+        return;
+      }
       if (a.facet != kNoId && b.facet != kNoId) {
         if (a.facet == b.facet) return;
         const auto key = std::make_pair(std::min(a.facet, b.facet), std::max(a.facet, b.facet));
@@ -892,6 +919,15 @@ class Preparer {
         if (SegTriImproper(s.index, t.facet, fc_.facets[t.facet].triangles[t.index])) sf.insert({s.index, t.facet});
       }
     });
+    if (!crossed_facets.empty()) {
+      const std::vector<uint32_t> ids(crossed_facets.begin(), crossed_facets.end());
+      std::vector<uint32_t> lines;
+      for (uint32_t f : ids) lines.push_back(FacetLine(f));
+      Error(ProblemKind::kUntriangulable,
+            Cat(ids.size() == 1 ? "facet " : "facets ", List(ids, base_, vo_.max_listed),
+                ": edges of its polygons cross each other", Lines(lines)),
+            ids, lines[0]);
+    }
     if (!ff.empty()) {
       std::vector<uint32_t> ids;
       std::string msg;

@@ -210,6 +210,32 @@ TEST(Validate, CoplanarOverlapAndTouchingInterior) {
   EXPECT_EQ(r.Find(ProblemKind::kIntersection), nullptr) << r.ToStatus();
 }
 
+// The input of random_plcs.py holed 2 reduced: a facet's hole loop crosses
+// its outer loop, with the facet's hole point inside both. The loop nesting
+// (decided by one vertex of the hole loop, which lies outside) made the hole
+// loop nobody's hole, the outer loop triangulated alone, and the validator
+// called the input VALID; meshing it ended "refined to the resolution of
+// doubles" (its spread was 3e16).
+TEST(Validate, HoleLoopCrossingItsOuterLoopIsRejected) {
+  Plc plc = Square();
+  plc.vertices.insert(plc.vertices.end(), {{1.25, 0.35, 0}, {1.25, 0.65, 0}, {0.75, 0.65, 0}, {0.75, 0.35, 0}});
+  plc.facets[0].polygons.push_back(Polygon{{4, 5, 6, 7}});
+  plc.facets[0].holes.push_back({0.9, 0.5, 0});
+  ValidationReport r = ValidatePlc(plc);
+  const Problem* x = r.Find(ProblemKind::kUntriangulable);
+  ASSERT_NE(x, nullptr) << r.ToStatus();
+  EXPECT_THAT(x->ids, ElementsAre(0));
+  EXPECT_THAT(x->message, HasSubstr("facet 0: edges of its polygons cross each other"));
+  // The same loop moved inside: a proper hole (a lone facet bounds no
+  // volume, the only error left).
+  for (uint32_t v = 4; v < 8; ++v) plc.vertices[v].x -= 0.3;
+  plc.facets[0].holes[0].x -= 0.3;
+  r = ValidatePlc(plc);
+  EXPECT_EQ(r.Find(ProblemKind::kUntriangulable), nullptr) << r.ToStatus();
+  EXPECT_EQ(r.Find(ProblemKind::kIntersection), nullptr) << r.ToStatus();
+  EXPECT_EQ(r.errors.size(), 1u) << r.ToStatus();
+}
+
 TEST(Validate, FinsInsideAClosedBoxAreAWarning) {
   Plc plc = MustRead("a_convex/cube.poly");
   // An internal fin attached to the bottom face's diagonal-free interior line x=0.5.
