@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/api.h"
+#include "core/geometry/predicates.h"
 #include "core/mesh/conformity.h"
 #include "core/mesh/crease_vertices.h"
 #include "core/mesh/quality.h"
@@ -36,7 +37,9 @@ double Det3(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
 }
 
-// The tets whose closure holds p (floating point; seeds sit well inside).
+// The tets whose closure holds p, by exact orientations; a flat tet holds
+// nothing (a floating-point test put a far seed inside a cluster of tets
+// 1e-9 across: random_plcs.py prism 59 before the collar shell).
 std::vector<size_t> TetsAround(const mesh::TetMesh& m, const Vec3& p) {
   std::vector<size_t> out;
   for (size_t t = 0; t < m.tets.size(); ++t) {
@@ -45,7 +48,9 @@ std::vector<size_t> TetsAround(const mesh::TetMesh& m, const Vec3& p) {
     const Vec3& b = m.positions[k[1]];
     const Vec3& c = m.positions[k[2]];
     const Vec3& d = m.positions[k[3]];
-    if (Det3(p, b, c, d) >= 0 && Det3(a, p, c, d) >= 0 && Det3(a, b, p, d) >= 0 && Det3(a, b, c, p) >= 0) {
+    if (geom::Orient3d(a, b, c, d) <= 0) continue;
+    if (geom::Orient3d(p, b, c, d) >= 0 && geom::Orient3d(a, p, c, d) >= 0 && geom::Orient3d(a, b, p, d) >= 0 &&
+        geom::Orient3d(a, b, c, p) >= 0) {
       out.push_back(t);
     }
   }

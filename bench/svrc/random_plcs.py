@@ -17,6 +17,10 @@ with repr, so they round-trip). Kinds (all inside or on the unit box):
             (attribute, sometimes a max volume), sometimes tilted or a hole
   holed     floating star-shaped facets with a polygonal hole, and a
             region bound on the box
+  fan       2-6 floating rectangles around one shared edge, angles between
+            them from 0.5 to 60 degrees
+  stack     a block standing on the floor (its footprint a polygon of the
+            floor facet), sometimes a rotated block on top of it, regions
 Some outputs are invalid PLCs (intersecting features); the sweep validates
 first and skips them.
 """
@@ -294,7 +298,8 @@ GENS['near'] = gen_near
 def star_polygon(rng, c, n, rmin, rmax):
     """n points around c (2D) at sorted random angles: a simple, star-shaped polygon."""
     angs = sorted(rng.uniform(0, 2 * math.pi) for _ in range(n))
-    if any(b - a < 1e-3 for a, b in zip(angs, angs[1:] + [angs[0] + 2 * math.pi])):
+    gaps = [b - a for a, b in zip(angs, angs[1:] + [angs[0] + 2 * math.pi])]
+    if min(gaps) < 1e-3 or max(gaps) > 0.9 * math.pi:  # a gap past pi: the edge passes c on the other side
         return None
     return [(c[0] + r * math.cos(a), c[1] + r * math.sin(a)) for a, r in ((a, rng.uniform(rmin, rmax)) for a in angs)]
 
@@ -358,8 +363,67 @@ def gen_holed(rng):
     regions = [(0.5, 0.5, 0.01, 7, rng.choice([1e-3, 1e-2]))]
     return nodes, facets, (), regions
 
+def gen_fan(rng):
+    nodes = list(BOX)
+    facets = box_facets()
+    c = rnd_interior(rng, 0.4, 0.6)
+    ax = [rng.gauss(0, 1) for _ in range(3)]; l = norm(ax); ax = tuple(x / l for x in ax)
+    if rng.random() < 0.4:
+        ax = (0.0, 0.0, 1.0)
+    u, v = plane_basis(ax)
+    h = rng.uniform(0.1, 0.3)
+    a0 = tuple(c[i] - h * ax[i] for i in range(3))
+    a1 = tuple(c[i] + h * ax[i] for i in range(3))
+    nodes += [a0, a1]
+    k = rng.randint(2, 6)
+    ang = rng.uniform(0, 2 * math.pi)
+    for j in range(k):
+        if j:
+            ang += math.radians(rng.choice([rng.uniform(0.5, 5), rng.uniform(5, 60)]))
+        w = rng.uniform(0.1, 0.3)
+        d = tuple(math.cos(ang) * u[i] + math.sin(ang) * v[i] for i in range(3))
+        b0 = tuple(a0[i] + w * d[i] for i in range(3))
+        b1 = tuple(a1[i] + w * d[i] for i in range(3))
+        nodes += [b1, b0]
+        facets.append(([[8, 9, len(nodes) - 2, len(nodes) - 1]], 3 + j))
+    if not all(0.01 < q[i] < 0.99 for q in nodes[8:] for i in range(3)):
+        return None
+    return nodes, facets
+
+def gen_stack(rng):
+    nodes = list(BOX)
+    x0, y0 = rng.uniform(0.1, 0.4), rng.uniform(0.1, 0.4)
+    x1, y1 = x0 + rng.uniform(0.2, 0.5), y0 + rng.uniform(0.2, 0.5)
+    z1 = rng.uniform(0.1, 0.6)
+    b = len(nodes)
+    nodes += [(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0), (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+    foot = [b, b + 1, b + 2, b + 3]
+    facets = box_facets({0: [foot]})
+    top = [b + 4, b + 5, b + 6, b + 7]
+    top_polys = [top]
+    regions = [(0.99, 0.99, 0.99, 1, 0.0), ((x0 + x1) / 2, (y0 + y1) / 2, z1 / 2, 2, rng.choice([0.0, 1e-3, 1e-4]))]
+    if rng.random() < 0.6:  # a block on top, rotated about z, inside the top face
+        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+        r = min(x1 - x0, y1 - y0) / 2 * rng.uniform(0.3, 0.95)
+        t = rng.uniform(0, math.pi / 2)
+        z2 = z1 + rng.uniform(0.05, 0.3)
+        ring = [(cx + r * math.cos(t + q * math.pi / 2), cy + r * math.sin(t + q * math.pi / 2)) for q in range(4)]
+        c0 = len(nodes)
+        nodes += [(x, y, z1) for x, y in ring] + [(x, y, z2) for x, y in ring]
+        top_polys.append([c0, c0 + 1, c0 + 2, c0 + 3])
+        facets.append(([[c0 + 4, c0 + 5, c0 + 6, c0 + 7]], 6))
+        for q in range(4):
+            facets.append(([[c0 + q, c0 + (q + 1) % 4, c0 + 4 + (q + 1) % 4, c0 + 4 + q]], 6))
+        regions.append((cx, cy, (z1 + z2) / 2, 3, rng.choice([0.0, 1e-3])))
+    facets.append((top_polys, 5))
+    for q in range(4):
+        facets.append(([[foot[q], foot[(q + 1) % 4], top[(q + 1) % 4], top[q]]], 5))
+    return nodes, facets, (), regions
+
 GENS['prism'] = gen_prism
 GENS['holed'] = gen_holed
+GENS['fan'] = gen_fan
+GENS['stack'] = gen_stack
 
 if __name__ == '__main__':
     kind, seed, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]

@@ -91,6 +91,12 @@ double Jitter(uint64_t id, uint64_t salt) {
   return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
 }
 constexpr double kJitter = 1e-6;
+// A new collar ball keeps every vertex at least kCollarShellGap of its radius
+// off its sphere, stepping its radius down from g/3 by that much at most
+// kCollarShellSteps times (CreateCollar). 2e-3: the RepBalls it leaves stay
+// well above kMinCollarRepairRatio (1e-4).
+constexpr double kCollarShellGap = 2e-3;
+constexpr int kCollarShellSteps = 8;
 
 Vec2 Mid2(Vec2 a, Vec2 b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y)}; }
 double HalfLen2(Vec2 a, Vec2 b) { return 0.5 * std::hypot(a.x - b.x, a.y - b.y); }
@@ -1715,10 +1721,11 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     // Duplicate input points were merged at Initialize and a warp target lying
     // in B is warped to rather than inserted next to, so a coincidence is a bug.
     const PointId q = omega_.PointOf(result.vertex);
+    const Vec3 at = norm_.Backward(pos);
     return absl::InternalError(absl::StrCat("SVRC: point ", p.value(), " (CD ", CdToString(points_.CdOf(p)), ", feature ",
                                             points_.Parent(p).value(), ") coincides with point ", q.value(), " (CD ",
                                             CdToString(points_.CdOf(q)), ", feature ", points_.Parent(q).value(),
-                                            ") of M_Ω at (", pos.x, ", ", pos.y, ", ", pos.z, ")"));
+                                            ") of M_Ω at (", at.x, ", ", at.y, ", ", at.z, ")"));
   }
   ++stats_.insertions;
   // Before any new tet (some in these slots) is tested and enqueued.
@@ -2346,7 +2353,44 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
     if (point_12) ++stats_.points_12_without_ball;
     return absl::OkStatus();
   }
-  const double rho = g.radius;
+  // The cells the ball may reach (a little beyond g/3: see the shell below).
+  std::vector<VertexId> cells;
+  CellsMeetingBall(pos, g.radius * (1 + kCollarShellGap), nv, &cells);
+  std::vector<std::pair<uint32_t, std::vector<VertexId2>>> facet_cells;
+  for (uint32_t f : FacetsThrough(p)) {
+    const Vec2 uv = Uv(f, p);
+    const VertexId2 w = facets_[f].dt().NearestVertex(uv);
+    facet_cells.emplace_back(f, std::vector<VertexId2>());
+    CellsMeetingDisk(f, uv, g.radius * (1 + kCollarShellGap), w, &facet_cells.back().second);
+  }
+  // No vertex within kCollarShellGap·ρ of the new sphere: the radius steps
+  // down from g/3 until none is (Lemma 13 only needs ρ <= g/3). A vertex
+  // that close to S makes the COLLAR rounds chase RepBalls far below the
+  // collar's radius. It happens by construction, not by chance: a neck
+  // split's ball has its neighbours' radius, and its centre (their
+  // midpoint) lies where an earlier segment vertex's Voronoi edge put an
+  // arc point of one neighbour's sphere on a facet, so the new sphere passed
+  // 1.4e-7 ρ from that arc point; facet refinement then split the two down
+  // to 1e-7 ρ and the rounds stopped at the RepBall floor (random_plcs.py
+  // prism 19 and 23).
+  std::vector<double> shell;  // |x - centre| / (g/3) of the vertices near the sphere
+  auto consider = [&](const Vec3& x) {
+    const double s = geom::Dist(x, pos) / g.radius;
+    if (std::abs(s - 1) < (kCollarShellSteps + 1) * kCollarShellGap) shell.push_back(s);
+  };
+  for (VertexId u : cells) consider(dt.Point(u));
+  for (const auto& [f, fc] : facet_cells) {
+    for (VertexId2 u : fc) consider(points_.Xyz(facets_[f].PointOf(u)));
+  }
+  double rho = g.radius;
+  for (int k = 0; k <= kCollarShellSteps; ++k) {
+    const double s0 = 1 - k * kCollarShellGap;
+    if (std::all_of(shell.begin(), shell.end(), [&](double s) { return std::abs(s - s0) >= kCollarShellGap; })) {
+      rho = g.radius * s0;
+      if (k > 0) ++stats_.collar_radii_stepped;
+      break;
+    }
+  }
   collars_.Add(CollarBall{pos, rho});
   collar_centre_.push_back(p);
   ++stats_.collars;
@@ -2371,18 +2415,12 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
     }
     return changed;
   };
-  std::vector<VertexId> cells;
-  CellsMeetingBall(pos, rho, nv, &cells);
   for (VertexId u : cells) {
     if (drop_suppressed(kOmegaMesh, u.value())) RefreshEvents(u);
   }
   // The facets through p: the collar's disk in each facet mesh.
-  std::vector<VertexId2> cells2;
-  for (uint32_t f : FacetsThrough(p)) {
-    const Vec2 uv = Uv(f, p);
-    const VertexId2 w = facets_[f].dt().NearestVertex(uv);
-    CellsMeetingDisk(f, uv, rho, w, &cells2);
-    for (VertexId2 u : cells2) {
+  for (const auto& [f, fc] : facet_cells) {
+    for (VertexId2 u : fc) {
       if (drop_suppressed(FacetMeshId(f), u.value())) RefreshFacetEvents(f, u);
     }
   }
@@ -2712,10 +2750,11 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
         collar_snap_ = options_.collar_snap_fallback;
         return true;
       }
+      const Vec3 at = norm_.Backward(r.x);  // the input's coordinates, as every message gives them
       return absl::FailedPreconditionError(absl::StrCat(
-          "SVRC: COLLAR ", kCollarRepairName[r.reason], " repair at (", r.x.x, ", ",
-          r.x.y, ", ", r.x.z, ") needs a point ", r.radius / ball_r, " collar radii from the nearest vertex; the ",
-          "collar surface sampling does not settle (ball ", r.ball, ", radius ", ball_r, ")"));
+          "SVRC: COLLAR ", kCollarRepairName[r.reason], " repair at (", at.x, ", ",
+          at.y, ", ", at.z, ") needs a point ", r.radius / ball_r, " collar radii from the nearest vertex; the ",
+          "collar surface sampling does not settle (ball ", r.ball, ", radius ", norm_.ToInputLength(ball_r), ")"));
     }
     const VertexId v = dt.NearestVertex(r.x, r.near.valid() ? dt.VertexTet(r.near) : TetId());
     if (dt.Point(v) == r.x) continue;
@@ -4129,6 +4168,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.collars", static_cast<double>(collars));
   out->Set("svrc.vertex_collars", static_cast<double>(vertex_collars));
   out->Set("svrc.collars_skipped_inside", static_cast<double>(collars_skipped_inside));
+  out->Set("svrc.collar_radii_stepped", static_cast<double>(collar_radii_stepped));
   out->Set("svrc.points_12", static_cast<double>(points_12));
   out->Set("svrc.points_12_skipped", static_cast<double>(points_12_skipped));
   out->Set("svrc.points_12_without_ball", static_cast<double>(points_12_without_ball));

@@ -335,6 +335,7 @@ struct RefineStats {
   uint64_t collars = 0;            // collar balls created (stage (d))
   uint64_t vertex_collars = 0;     // of those, centred on an input vertex
   uint64_t collars_skipped_inside = 0;  // crease points strictly inside a collar: no ball
+  uint64_t collar_radii_stepped = 0;    // balls made smaller than g/3 to keep vertices off their sphere
   uint64_t collar_cells_explored = 0;  // FastCollarSize cells popped, summed (Lemma 35)
   uint64_t max_collar_cells = 0;
   uint64_t suppressed_points = 0;  // unresolved points dropped inside collars (Figure 3.9)
