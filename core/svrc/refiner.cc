@@ -324,6 +324,7 @@ class Refiner {
   // The exact distance from x to feature f (normalised coordinates), +inf if
   // point p lies on f (combinatorially) or f is Ω.
   double FeatureDistance(FeatureId f, PointId p, const Vec3& x) const;
+  double FacetGapOnSphere(const Vec3& x, uint32_t ball) const;
   // Does feature f contain point p (an input point or a segment point)?
   bool FeatureContains(FeatureId f, PointId p) const;
   // Facets whose feature contains p, sorted (none for a point of Ω).
@@ -2278,6 +2279,33 @@ double Refiner::FeatureDistance(FeatureId f, PointId p, const Vec3& x) const {
   return best;
 }
 
+double Refiner::FacetGapOnSphere(const Vec3& x, uint32_t ball) const {
+  // How far apart the facets through the ball's centre are at x (on its
+  // sphere): the sum of x's two smallest distances to them (x's own facet
+  // counts 0); infinity with fewer than two.
+  double d0 = std::numeric_limits<double>::infinity(), d1 = d0;
+  for (uint32_t idx : FacetsThrough(collar_centre_[ball])) {
+    const plc::FacetFrame& fr = frames_[idx];
+    double d;
+    if (facets_[idx].region().Locate(fr.ToPlane(x)) != FacetRegion::Where::kOutside) {
+      d = std::abs(geom::Dot(x - fr.origin, fr.normal));
+    } else {
+      d = std::numeric_limits<double>::infinity();
+      for (uint32_t sg : complex_->facets[idx].segments) {
+        const plc::FeatureSegment& fs = complex_->segments[sg];
+        d = std::min(d, plc::PointSegmentDistance(x, points_.Xyz(PointId(fs.a)), points_.Xyz(PointId(fs.b))));
+      }
+    }
+    if (d < d0) {
+      d1 = d0;
+      d0 = d;
+    } else if (d < d1) {
+      d1 = d;
+    }
+  }
+  return d0 + d1;
+}
+
 bool Refiner::Suppressed(PointId p) {
   if (!options_.collars || collars_.size() == 0 || points_.IsCrease(p)) return false;
   if (points_.CdOf(p).collar < 3) return false;  // constructed on S: resolved (Definition 37)
@@ -2742,7 +2770,14 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     // schonhardt.off: ~500 topology repairs per round at radii 1e-7..1e-8
     // for 70+ rounds): stop with a precise error instead of running on.
     const double ball_r = collars_.ball(r.ball).radius;
-    if (r.radius < kMinCollarRepairRatio * ball_r) {
+    // The floor is relative to the ball's radius, or to the gap between the
+    // facets through its centre at x when that is smaller: two facets at a
+    // dihedral angle θ leave arcs ρθ apart on the sphere, and the sampling
+    // of S between them legitimately needs RepBalls of that scale
+    // (random_plcs.py tet 20, θ = 0.29°: the fallback to the snap band, and
+    // stars of σ 89.6°, came from repairs 9e-5ρ next to a facet's arc).
+    if (r.radius < kMinCollarRepairRatio * ball_r &&
+        !(r.radius >= kMinCollarRepairRatio * FacetGapOnSphere(r.x, r.ball))) {
       if (collar_snap_ < options_.collar_snap_fallback) {
         // The true angles chase a vertex close to S (RefineOptions::
         // collar_snap): from here on the thesis' snap band; the points of
