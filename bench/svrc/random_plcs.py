@@ -104,13 +104,17 @@ def cross(a, b):
 def norm(a):
     return math.sqrt(sum(x*x for x in a))
 
+def random_unit(rng):
+    n = [rng.gauss(0, 1) for _ in range(3)]; l = norm(n)
+    return tuple(x / l for x in n)
+
 def gen_float(rng):
     nodes = list(BOX)
     facets = box_facets()
     k = rng.randint(1, 3)
     for _ in range(k):
         c = rnd_interior(rng, 0.3, 0.7)
-        n = [rng.gauss(0, 1) for _ in range(3)]; l = norm(n); n = tuple(x/l for x in n)
+        n = random_unit(rng)
         # sometimes nearly axis aligned
         if rng.random() < 0.3:
             n = list(n); j = rng.randrange(3)
@@ -132,7 +136,7 @@ def gen_float(rng):
 def gen_cut(rng):
     nodes = list(BOX)
     c = rnd_interior(rng, 0.35, 0.65)
-    n = [rng.gauss(0, 1) for _ in range(3)]; l = norm(n); n = tuple(x/l for x in n)
+    n = random_unit(rng)
     d = sum(n[i]*c[i] for i in range(3))
     s = [sum(n[i]*p[i] for i in range(3)) - d for p in BOX]
     if min(abs(x) for x in s) < 1e-3:
@@ -347,7 +351,7 @@ def gen_holed(rng):
     k = rng.randint(1, 2)
     for _ in range(k):
         c3 = rnd_interior(rng, 0.35, 0.65)
-        nrm = [rng.gauss(0, 1) for _ in range(3)]; l = norm(nrm); nrm = tuple(x / l for x in nrm)
+        nrm = random_unit(rng)
         if rng.random() < 0.4:
             nrm = (0.0, 0.0, 1.0)
         u, v = plane_basis(nrm)
@@ -367,7 +371,7 @@ def gen_fan(rng):
     nodes = list(BOX)
     facets = box_facets()
     c = rnd_interior(rng, 0.4, 0.6)
-    ax = [rng.gauss(0, 1) for _ in range(3)]; l = norm(ax); ax = tuple(x / l for x in ax)
+    ax = random_unit(rng)
     if rng.random() < 0.4:
         ax = (0.0, 0.0, 1.0)
     u, v = plane_basis(ax)

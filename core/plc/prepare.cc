@@ -126,6 +126,14 @@ class Preparer {
     rep_.warnings.push_back({k, Cat(plc_.source_name.empty() ? "<memory>" : plc_.source_name, ": ", msg),
                              std::move(ids), line});
   }
+  // kUntriangulable naming the facets (0-based ids) and their lines.
+  void UntriangulableError(const std::vector<uint32_t>& facets, const char* why) {
+    std::vector<uint32_t> lines;
+    for (uint32_t f : facets) lines.push_back(FacetLine(f));
+    Error(ProblemKind::kUntriangulable,
+          Cat(facets.size() == 1 ? "facet " : "facets ", List(facets, base_, vo_.max_listed), why, Lines(lines)), facets,
+          lines[0]);
+  }
   uint32_t VertexLine(uint32_t v) const { return v < plc_.vertex_lines.size() ? plc_.vertex_lines[v] : 0; }
   uint32_t FacetLine(uint32_t f) const { return f < plc_.facet_lines.size() ? plc_.facet_lines[f] : 0; }
   std::string Lines(const std::vector<uint32_t>& lines) const {
@@ -599,14 +607,7 @@ class Preparer {
         failed.push_back(f);
       }
     }
-    if (!failed.empty()) {
-      std::vector<uint32_t> lines;
-      for (uint32_t f : failed) lines.push_back(FacetLine(f));
-      Error(ProblemKind::kUntriangulable,
-            Cat(failed.size() == 1 ? "facet " : "facets ", List(failed, base_, vo_.max_listed),
-                ": polygons are not simple or cross each other (cannot triangulate)", Lines(lines)),
-            failed, lines[0]);
-    }
+    if (!failed.empty()) UntriangulableError(failed, ": polygons are not simple or cross each other (cannot triangulate)");
   }
 
   // ---- (6) isolated points and free segment ends inside facets
@@ -920,13 +921,7 @@ class Preparer {
       }
     });
     if (!crossed_facets.empty()) {
-      const std::vector<uint32_t> ids(crossed_facets.begin(), crossed_facets.end());
-      std::vector<uint32_t> lines;
-      for (uint32_t f : ids) lines.push_back(FacetLine(f));
-      Error(ProblemKind::kUntriangulable,
-            Cat(ids.size() == 1 ? "facet " : "facets ", List(ids, base_, vo_.max_listed),
-                ": edges of its polygons cross each other", Lines(lines)),
-            ids, lines[0]);
+      UntriangulableError({crossed_facets.begin(), crossed_facets.end()}, ": edges of its polygons cross each other");
     }
     if (!ff.empty()) {
       std::vector<uint32_t> ids;
