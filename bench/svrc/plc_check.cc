@@ -30,13 +30,6 @@ namespace {
 using namespace svrc;
 using geom::Vec3;
 
-double Det3(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double ax = a.x - d.x, ay = a.y - d.y, az = a.z - d.z;
-  const double bx = b.x - d.x, by = b.y - d.y, bz = b.z - d.z;
-  const double cx = c.x - d.x, cy = c.y - d.y, cz = c.z - d.z;
-  return ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
-}
-
 // The tets whose closure holds p, by exact orientations; a flat tet holds
 // nothing (a floating-point test put a far seed inside a cluster of tets
 // 1e-9 across: random_plcs.py prism 59 before the collar shell).
@@ -107,7 +100,8 @@ int main(int argc, char** argv) {
     const double rv = m->regions[m->tet_region[t]].max_volume;
     if (rv <= 0) continue;
     const auto& k = m->tets[t];
-    const double v = Det3(m->positions[k[0]], m->positions[k[1]], m->positions[k[2]], m->positions[k[3]]) / 6;
+    const double v =
+        mesh::ComputeTetQuality(m->positions[k[0]], m->positions[k[1]], m->positions[k[2]], m->positions[k[3]]).volume;
     if (std::abs(v) > rv * (1 + 1e-9)) region_ok = false;
   }
   bool seeds_ok = true;

@@ -324,6 +324,9 @@ class Refiner {
   // The exact distance from x to feature f (normalised coordinates), +inf if
   // point p lies on f (combinatorially) or f is Ω.
   double FeatureDistance(FeatureId f, PointId p, const Vec3& x) const;
+  // The distance from x to facet idx (normalised coordinates).
+  double FacetDistance(uint32_t idx, const Vec3& x) const;
+  // How far apart the facets through a collar ball's centre are at x.
   double FacetGapOnSphere(const Vec3& x, uint32_t ball) const;
   // Does feature f contain point p (an input point or a segment point)?
   bool FeatureContains(FeatureId f, PointId p) const;
@@ -2265,13 +2268,17 @@ double Refiner::FeatureDistance(FeatureId f, PointId p, const Vec3& x) const {
     const plc::FeatureSegment& sg = complex_->segments[idx];
     return plc::PointSegmentDistance(x, points_.Xyz(PointId(sg.a)), points_.Xyz(PointId(sg.b)));
   }
-  // A facet: its plane if x projects into the facet, else its nearest segment
-  // (every polygon edge is a segment of the complex).
+  return FacetDistance(idx, x);
+}
+
+double Refiner::FacetDistance(uint32_t idx, const Vec3& x) const {
+  // Its plane if x projects into the facet, else its nearest segment (every
+  // polygon edge is a segment of the complex).
   const plc::FacetFrame& fr = frames_[idx];
   if (facets_[idx].region().Locate(fr.ToPlane(x)) != FacetRegion::Where::kOutside) {
     return std::abs(geom::Dot(x - fr.origin, fr.normal));
   }
-  double best = kInf;
+  double best = std::numeric_limits<double>::infinity();
   for (uint32_t sg : complex_->facets[idx].segments) {
     const plc::FeatureSegment& fs = complex_->segments[sg];
     best = std::min(best, plc::PointSegmentDistance(x, points_.Xyz(PointId(fs.a)), points_.Xyz(PointId(fs.b))));
@@ -2285,17 +2292,7 @@ double Refiner::FacetGapOnSphere(const Vec3& x, uint32_t ball) const {
   // counts 0); infinity with fewer than two.
   double d0 = std::numeric_limits<double>::infinity(), d1 = d0;
   for (uint32_t idx : FacetsThrough(collar_centre_[ball])) {
-    const plc::FacetFrame& fr = frames_[idx];
-    double d;
-    if (facets_[idx].region().Locate(fr.ToPlane(x)) != FacetRegion::Where::kOutside) {
-      d = std::abs(geom::Dot(x - fr.origin, fr.normal));
-    } else {
-      d = std::numeric_limits<double>::infinity();
-      for (uint32_t sg : complex_->facets[idx].segments) {
-        const plc::FeatureSegment& fs = complex_->segments[sg];
-        d = std::min(d, plc::PointSegmentDistance(x, points_.Xyz(PointId(fs.a)), points_.Xyz(PointId(fs.b))));
-      }
-    }
+    const double d = FacetDistance(idx, x);
     if (d < d0) {
       d1 = d0;
       d0 = d;
