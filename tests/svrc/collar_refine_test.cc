@@ -1053,7 +1053,7 @@ TEST(CollarRefine, SizeRoundsSkippingUnchangedLabelsGiveTheSameRefinement) {
 // vertices added between two reports stay far below one round's repairs
 // (knife_edge.poly's round 0: ~230 points on S and ~200 on facet arcs).
 TEST(CollarRefine, CollarRoundsPollBetweenRepairs) {
-  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/schonhardt.off"));
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("c_creases/knife_edge.poly"));
   ASSERT_TRUE(plc.ok()) << plc.status();
   absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
   ASSERT_TRUE(cx.ok()) << cx.status();
