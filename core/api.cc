@@ -458,8 +458,12 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   double sharpest = 90;
   const std::string crease = FirstCrease(*complex, &sharpest);
   bool use_collars = !crease.empty() && sharpest < kCollarAngleDeg;
-  // The head of every collar-stage error: the crease and its angle.
-  const std::string crease_head = absl::StrCat("SVRC: ", crease, " (sharpest ", sharpest, " degrees): ");
+  // The head of every collar-stage error: the crease and its angle (none
+  // for a crease point off the crease segments, whose 0 only means "always
+  // collared": random_plcs.py near 9's message said "sharpest 0 degrees" of
+  // a triangle's 37° corner).
+  const std::string crease_head =
+      absl::StrCat("SVRC: ", crease, sharpest > 0 ? absl::StrCat(" (sharpest ", sharpest, " degrees)") : "", ": ");
   const auto set_collar_options = [&]() {
     options.collars = true;
     options.collar_surface = true;

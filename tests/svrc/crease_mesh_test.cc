@@ -1250,5 +1250,62 @@ TEST(CreaseMesh, NewCollarSpheresKeepOffExistingVertices) {
   EXPECT_EQ(out.stats.Get("svrc.collar_snap"), 0);
 }
 
+// random_plcs.py near 9 with its gap doubled: two floating triangles 4.9e-5
+// apart over each other, their corners collared (37°–84° corners). A
+// stitched tet's edge crossed the lower triangle an ulp (1.4e-17..4.2e-17)
+// from a vertex of its facet mesh; the repair inserted that point, whose
+// encroachment split segment 14 and the facet down to pieces of 1e-16
+// (INTERNAL "segment 14 piece too short to split"). The original near 9
+// (gap 2.4e-5, 1.75·10⁶ tets, ~45 s) failed the same way in the COLLAR
+// rounds' crossing check ("facet mesh 6 was refined to the resolution of
+// doubles"). Now such a crossing is the vertex (kSampledArcPointRatio).
+// ~10 s in release, 524,257 tets.
+constexpr const char* kNearlyTouchingTriangles = R"(14 3 0 0
+1 0 0 0
+2 1 0 0
+3 1 1 0
+4 0 1 0
+5 0 0 1
+6 1 0 1
+7 1 1 1
+8 0 1 1
+9 0.6009765408105556 0.5846688586690023 0.42509342901536584
+10 0.3978304341430448 0.631638345599474 0.42508820507821016
+11 0.3807890016592257 0.4864507035226766 0.42509505442050366
+12 0.4212409948353102 0.6863822514724598 0.4251418225629935
+13 0.3362249389217621 0.5150174634395298 0.425123197871335
+14 0.35601659727599466 0.4666016320624646 0.4251817092412936
+8 1
+1 0 1
+4 1 4 3 2
+1 0 1
+4 5 6 7 8
+1 0 1
+4 1 2 6 5
+1 0 1
+4 2 3 7 6
+1 0 1
+4 3 4 8 7
+1 0 1
+4 4 1 5 8
+1 0 3
+3 9 10 11
+1 0 3
+3 12 13 14
+0
+0
+)";
+
+TEST(CreaseMesh, CrossingsAnUlpFromAFacetVertexAreThatVertex) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "release only";
+#endif
+  const CreaseMeshed out = MeshPolyTextAndCheck(kNearlyTouchingTriangles, "near_9_gap2.poly",
+                                                "two triangles 4.9e-5 apart, crossings an ulp from facet vertices");
+  EXPECT_GT(out.tets, 0u);
+  EXPECT_GT(out.stats.Get("svrc.crossings_at_vertices"), 0);
+  EXPECT_EQ(out.stats.Get("svrc.collar_snap"), 0);
+}
+
 }  // namespace
 }  // namespace svrc
