@@ -84,6 +84,10 @@ bool SegmentMeetsTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec
   return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
 }
 
+bool SegmentsMeetProjected(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s, int drop) {
+  return Segments2d(p, q, r, s, drop);
+}
+
 bool SegmentsMeet(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s) {
   if (Orient3dSign(p, q, r, s) != 0) return false;
   for (int d = 0; d < 3; ++d) {

@@ -15,6 +15,12 @@ bool SegmentMeetsTriangle(const geom::Vec3& p, const geom::Vec3& q, const geom::
 bool SegmentsMeet(const geom::Vec3& p, const geom::Vec3& q, const geom::Vec3& r,
                   const geom::Vec3& s);
 
+// Do the closed segments pq and rs meet in the projection dropping axis
+// `drop`? For edges of one facet, whose points are coplanar only up to
+// rounding when the facet is slanted (SegmentsMeet needs exact coplanarity).
+bool SegmentsMeetProjected(const geom::Vec3& p, const geom::Vec3& q, const geom::Vec3& r,
+                           const geom::Vec3& s, int drop);
+
 // A projection axis (to drop) in which the non-degenerate triangle abc keeps
 // a non-zero orientation; -1 if abc is degenerate (collinear points).
 int FaithfulDrop(const geom::Vec3& a, const geom::Vec3& b, const geom::Vec3& c);

@@ -849,6 +849,27 @@ class Preparer {
     return (P_[a][k] > P_[v][k]) == (P_[b][k] > P_[v][k]);
   }
 
+  // Do edges i and j of facet f cross or overlap (other than at a shared
+  // endpoint)? Decided in f's projection: a slanted facet's points are
+  // coplanar only up to rounding, and the 3D test (SegSegImproper) needs
+  // exact coplanarity (random_plcs.py holed 85: a hole loop crossing the
+  // outer loop of a slanted facet was VALID).
+  bool FacetSegSegImproper(SegmentId i, SegmentId j, FacetId f) const {
+    const int drop = work_[f].drop;
+    const FeatureSegment& s = fc_.segments[i];
+    const FeatureSegment& t = fc_.segments[j];
+    PointId v = kNoId, a = kNoId, b = kNoId;
+    if (s.a == t.a || s.a == t.b) v = s.a, a = s.b, b = s.a == t.a ? t.b : t.a;
+    else if (s.b == t.a || s.b == t.b) v = s.b, a = s.a, b = s.b == t.a ? t.b : t.a;
+    if (v == kNoId) return SegmentsMeetProjected(P_[s.a], P_[s.b], P_[t.a], P_[t.b], drop);
+    if (Orient2dSign(P_[v], P_[a], P_[b], drop) != 0) return false;
+    // Collinear in the projection: they overlap iff a and b are on one side of v.
+    const int i2 = (drop + 1) % 3, j2 = (drop + 2) % 3;
+    const Vec3 e = P_[a] - P_[v];
+    const int k = std::fabs(e[i2]) >= std::fabs(e[j2]) ? i2 : j2;
+    return (P_[a][k] > P_[v][k]) == (P_[b][k] > P_[v][k]);
+  }
+
   void CheckIntersections() {
     // Primitives: triangles of usable facets, free segments on no facet.
     // Segments of facets take part in the segment-segment test only: two
@@ -896,13 +917,15 @@ class Preparer {
       const Prim& b = prims[j];
       if (a.facet_segment || b.facet_segment) {
         if (a.facet != kNoId || b.facet != kNoId) return;  // a facet's segment and a triangle
-        if (!SegSegImproper(a.index, b.index)) return;
         const std::vector<FacetId>& fa = fc_.segments[a.index].facets;
         const std::vector<FacetId>& fb = fc_.segments[b.index].facets;
         // Edges of two facets that cross make their triangles cross too
         // (reported below); edges of one facet are this test's own finding.
         for (FacetId f : fa) {
-          if (several_loops(f) && std::find(fb.begin(), fb.end(), f) != fb.end()) crossed_facets.insert(f);
+          if (several_loops(f) && std::find(fb.begin(), fb.end(), f) != fb.end() &&
+              FacetSegSegImproper(a.index, b.index, f)) {
+            crossed_facets.insert(f);
+          }
         }
         return;
       }
