@@ -21,6 +21,9 @@ with repr, so they round-trip). Kinds (all inside or on the unit box):
             them from 0.5 to 60 degrees
   stack     a block standing on the floor (its footprint a polygon of the
             floor facet), sometimes a rotated block on top of it, regions
+KIND+rot (e.g. prism+rot) is KIND's PLC turned by a random rotation about
+the box's centre (session 38): every facet is then slanted, its points
+coplanar only up to rounding.
 Some outputs are invalid PLCs (intersecting features); the sweep validates
 first and skips them.
 """
@@ -429,10 +432,33 @@ GENS['holed'] = gen_holed
 GENS['fan'] = gen_fan
 GENS['stack'] = gen_stack
 
+def random_rotation(rng):
+    """A uniformly random rotation matrix (a unit quaternion of four normal deviates)."""
+    q = [rng.gauss(0, 1) for _ in range(4)]
+    n = math.sqrt(sum(x * x for x in q))
+    w, x, y, z = (c / n for c in q)
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+def rotate_plc(rng, nodes, facets, holes=(), regions=()):
+    m = random_rotation(rng)
+    def rot(p):
+        d = [p[k] - 0.5 for k in range(3)]
+        return tuple(0.5 + sum(m[i][k] * d[k] for k in range(3)) for i in range(3))
+    nodes = [rot(p) for p in nodes]
+    facets = [(f[0], f[1], [rot(h) for h in f[2]]) if len(f) > 2 else f for f in facets]
+    holes = [rot(h) for h in holes]
+    regions = [rot(r[:3]) + tuple(r[3:]) for r in regions]
+    return nodes, facets, holes, regions
+
 if __name__ == '__main__':
     kind, seed, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-    rng = random.Random(seed * 1000 + list(GENS).index(kind))
+    base, rotated = (kind[:-4], True) if kind.endswith('+rot') else (kind, False)
+    rng = random.Random(seed * 1000 + list(GENS).index(base))
     r = None
     while r is None:
-        r = GENS[kind](rng)
+        r = GENS[base](rng)
+    if rotated:
+        r = rotate_plc(random.Random(seed * 1000 + 999), *r)
     write_poly(out, *r)
