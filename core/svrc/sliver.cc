@@ -914,6 +914,14 @@ bool FlipMesh::Search(uint32_t t, int depth, double floor, std::vector<Flip>* se
     ForEachFlip(s, /*above_old=*/false, prune, [&](const Flip& f1) {
       if (f1.Replaces(t) || !(f1.new_min > floor)) return;
       if (found && !(f1.new_min > *score)) return;  // cannot beat the best sequence
+      // The crease rule of BestFlip holds for every flip of a sequence: a
+      // first flip that gave a tet touching a crease a larger dihedral than
+      // the tets it replaced made random_plcs.py float 104's 132.9° next to
+      // a crease corner, above the stitched stars' 129.5°.
+      if (RaisesCreaseAngle(f1)) {
+        ++stats_->rejected_crease_angle;
+        return;
+      }
       Journal journal;
       journal.num_slots = tet_.size();
       journal.free_size = free_.size();

@@ -1307,5 +1307,46 @@ TEST(CreaseMesh, CrossingsAnUlpFromAFacetVertexAreThatVertex) {
   EXPECT_EQ(out.stats.Get("svrc.collar_snap"), 0);
 }
 
+// random_plcs.py float 104: one acute triangle floating in the box, its
+// three corners collared. The sliver pass's lookahead took a sequence whose
+// first flip gave a tet at a corner a dihedral of 132.9°, above the
+// stitched stars' largest (129.5°): only the single flips checked the crease
+// rule. Now every flip of a sequence does. ~0.1 s.
+constexpr const char* kFloatingTriangle104 = R"(11 3 0 0
+1 0 0 0
+2 1 0 0
+3 1 1 0
+4 0 1 0
+5 0 0 1
+6 1 0 1
+7 1 1 1
+8 0 1 1
+9 0.5410276958198146 0.5150099848825869 0.5177231846813493
+10 0.5411725501100354 0.45417249598150894 0.32470200598147275
+11 0.5409482469293468 0.6422626015659052 0.4735721191305763
+7 1
+1 0 1
+4 1 4 3 2
+1 0 1
+4 5 6 7 8
+1 0 1
+4 1 2 6 5
+1 0 1
+4 2 3 7 6
+1 0 1
+4 3 4 8 7
+1 0 1
+4 4 1 5 8
+1 0 3
+3 9 10 11
+0
+0
+)";
+
+TEST(CreaseMesh, SliverSequencesKeepTheStitchedDihedralBound) {
+  const CreaseMeshed out = MeshPolyTextAndCheck(kFloatingTriangle104, "float_104.poly", "floating triangle, float 104");
+  EXPECT_GT(out.stats.Get("sliver.rejected_crease_angle"), 0);
+}
+
 }  // namespace
 }  // namespace svrc
