@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/geometry/predicates.h"
@@ -305,6 +306,17 @@ BookBound BookDihedralBound(double sigma, double eps, double alpha) {
   b.side = pi / 2 + tilt;
   b.axis = 2 * std::asin(eps);
   return b;
+}
+
+bool SegmentCrossesPlane(const Vec3& origin, const Vec3& normal, const Vec3& pa, const Vec3& pb, double tol,
+                         Vec3* x) {
+  double scale = 0;
+  for (int k = 0; k < 3; ++k) scale = std::max({scale, std::fabs(pa[k]), std::fabs(pb[k]), std::fabs(origin[k])});
+  tol = std::max(tol, 16 * std::numeric_limits<double>::epsilon() * scale);
+  const double ha = geom::Dot(pa - origin, normal), hb = geom::Dot(pb - origin, normal);
+  if (!((ha > tol && hb < -tol) || (ha < -tol && hb > tol))) return false;
+  *x = pa + (ha / (ha - hb)) * (pb - pa);
+  return true;
 }
 
 }  // namespace svrc::refine

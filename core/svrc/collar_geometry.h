@@ -21,6 +21,18 @@ struct CollarBall {
   double radius = 0;
 };
 
+// Segment pa–pb crosses the plane through `origin` with unit `normal`: its
+// ends strictly on opposite sides beyond tol, or beyond the rounding of a
+// point of the plane (16 ulps of the coordinates) when that is larger;
+// *x = the crossing. A segment's collar point and a facet's own points lie on
+// the facet's plane only up to rounding: on a slanted facet next to a small
+// collar ball (random_plcs.py near+rot 9, ρ = 4.9e-6) a (1,2) point
+// 6.9e-18 = 1.4e-12ρ off the plane passed tol = 1e-12ρ, the T′ edges from it
+// "crossed" the facet, and the arc points put there were chased down to the
+// resolution of doubles.
+bool SegmentCrossesPlane(const Vec3& origin, const Vec3& normal, const Vec3& pa, const Vec3& pb, double tol,
+                         Vec3* x);
+
 // A circle in 3D: centre, unit normal, radius.
 struct Circle3 {
   Vec3 center;

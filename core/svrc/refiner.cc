@@ -740,7 +740,6 @@ class Refiner {
   // chords of T′ (RepairStitchedCrossings).
   uint32_t stitched_arc_crossings_ = 0;
   uint32_t stitched_crossings_ = 0;  // all points for stitched tets crossing a facet
-  uint32_t crossings_at_vertices_ = 0;  // facet crossings skipped: at a vertex of M_F up to rounding
  private:
   RefineStats stats_;
   uint64_t budget_ = 0;
@@ -2491,13 +2490,9 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   return absl::OkStatus();
 }
 
-// Segment pa–pb crosses the plane of frame fr, its ends strictly on opposite
-// sides beyond tol; *x = the crossing.
+// SegmentCrossesPlane (collar_geometry.h) for the plane of frame fr.
 bool CrossesPlane(const plc::FacetFrame& fr, const Vec3& pa, const Vec3& pb, double tol, Vec3* x) {
-  const double ha = geom::Dot(pa - fr.origin, fr.normal), hb = geom::Dot(pb - fr.origin, fr.normal);
-  if (!((ha > tol && hb < -tol) || (ha < -tol && hb > tol))) return false;
-  *x = pa + (ha / (ha - hb)) * (pb - pa);
-  return true;
+  return SegmentCrossesPlane(fr.origin, fr.normal, pa, pb, tol, x);
 }
 
 // The point of the circle where `ball`'s sphere meets the plane of frame fr
@@ -2520,9 +2515,6 @@ constexpr const char* kCollarRepairName[] = {"topology", "angle", "circle", "siz
 
 // Smallest RepBall accepted, relative to its collar ball's radius.
 constexpr double kMinCollarRepairRatio = 1e-4;
-// A facet-crossing arc point this close to a vertex of M_F, relative to its
-// collar ball's radius, is that vertex up to rounding.
-constexpr double kSampledArcPointRatio = 1e-9;
 
 std::vector<Refiner::CreaseBallPair> Refiner::CreaseBallPairs() const {
   std::vector<uint32_t> ball_of(points_.size(), CollarIndex::kNone);
@@ -2722,12 +2714,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
   std::stable_sort(reps.begin(), reps.end(), [](const CollarRepair& a, const CollarRepair& b) { return a.radius > b.radius; });
   bool any = false;
   const delaunay::Delaunay3& dt = omega_.dt();
-  struct Crossing {
-    uint32_t facet;
-    Vec2 q;         // the arc point, uv
-    double radius;  // its collar ball's radius
-  };
-  std::vector<Crossing> crossings;  // of this round
+  std::vector<std::pair<uint32_t, Vec2>> crossings;  // (facet, arc point uv) of this round
   // The facet-crossing check (below) once the restricted triangulation's
   // topology has held in some round (no topology or circle repair): from
   // then on every round, so its arc points go in with the angle repairs
@@ -2755,7 +2742,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
           Vec2 q;
           if (!NearestArcPoint(fr, ball, fr.ToPlane(x), &q)) continue;
           if (facets_[f].region().Locate(q) == FacetRegion::Where::kOutside) continue;
-          crossings.push_back({f, q, ball.radius});
+          crossings.push_back({f, q});
         }
       }
     }
@@ -2863,7 +2850,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
     std::stable_sort(ar.begin(), ar.end(), [](const ArcRepair& a, const ArcRepair& b) {
       return a.collar_dim < b.collar_dim || (a.collar_dim == b.collar_dim && a.radius > b.radius);
     });
-    for (const auto& [cf, q, ball_r] : crossings) {
+    for (const auto& [cf, q] : crossings) {
       // All of a round's crossings go in together, next to its arc repairs
       // (measured: one facet crossing per round left crease_pair 1° unsettled
       // after 256 rounds with 227 crossings; together, 1° settles and
@@ -2875,18 +2862,8 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
       const VertexId2 w = m.dt().NearestVertex(q);
       const Vec2 pw = m.dt().Point(w);
       r.radius = std::hypot(pw.x - q.x, pw.y - q.y);
-      // Already sampled there: a vertex of M_F at the arc point up to
-      // rounding. An arc's end on a segment of F is that segment's collar
-      // point, computed on the segment; the crossing's arc point, computed
-      // from the sphere in F's frame, lands an ulp off it (random_plcs.py
-      // near 9: 3.1e-17 away, ρ = 4.9e-6). Inserting it made a facet point an
-      // ulp from a segment point, whose encroachment split the segment and
-      // the facet down to 1e-16 until two points coincided ("facet mesh 6
-      // was refined to the resolution of doubles").
-      if (!(r.radius > kSampledArcPointRatio * ball_r)) {
-        if (r.radius > 0) ++crossings_at_vertices_;
-        continue;
-      }
+      // Already sampled there (the crossing is within a tenth of the gap).
+      if (!(r.radius > 0)) continue;
       ar.push_back(r);
       ++crossing_count_;
     }
@@ -3007,7 +2984,7 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
     b.radius *= 1.5;
     near.Add(b);
   }
-  std::vector<std::tuple<uint32_t, double, double, bool, double>> hits;  // facet, u, v, on an arc, ball radius
+  std::vector<std::tuple<uint32_t, double, double, bool>> hits;  // facet, u, v, on an arc
   for (const auto& t : stitched_) {
     uint32_t bi = CollarIndex::kNone;
     for (uint32_t p : t) {
@@ -3050,8 +3027,7 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
             if (other != CollarIndex::kNone && other != in) continue;
           }
           if (facets_[f].region().Locate(uv) != FacetRegion::Where::kInside) continue;
-          hits.emplace_back(f, uv.x, uv.y, in != CollarIndex::kNone,
-                            collars_.ball(in != CollarIndex::kNone ? in : bi).radius);
+          hits.emplace_back(f, uv.x, uv.y, in != CollarIndex::kNone);
         }
       }
     }
@@ -3059,20 +3035,13 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
   std::sort(hits.begin(), hits.end());
   hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
   uint32_t inserted = 0;
-  for (const auto& [f, u, v, on_arc, ball_r] : hits) {
+  for (const auto& [f, u, v, on_arc] : hits) {
     FacetMesh& m = facets_[f];
     const Vec2 c{u, v};
     const VertexId2 w = m.dt().NearestVertex(c);
     const Vec2 pw = m.dt().Point(w);
     const double d = std::hypot(pw.x - c.x, pw.y - c.y);
-    // A vertex of M_F there up to rounding (as in CollarRound; random_plcs.py
-    // near 9 with its gap doubled: three hits 1.4e-17..4.2e-17 from
-    // vertices, ρ = 8.9e-6, ended INTERNAL "segment 14 piece too short to
-    // split").
-    if (!(d > kSampledArcPointRatio * ball_r)) {
-      if (d > 0) ++crossings_at_vertices_;
-      continue;
-    }
+    if (!(d > 0)) continue;
     const TriId2 hint = m.dt().Locate(c, m.dt().VertexTri(w));
     absl::Status st = DestroyFacet(f, c, d, hint, TriId2(), on_arc ? Cd{2, 2} : kCdFacet, /*jitter=*/false);
     if (!st.ok()) return st;
@@ -4028,7 +3997,6 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.arc_repairs = arc_repairs_;
   st.stitched_arc_crossings = stitched_arc_crossings_;
   st.stitched_crossings = stitched_crossings_;
-  st.crossings_at_vertices = crossings_at_vertices_;
   st.steiner_vertices = st.vertices - 8 - st.input_vertices - segment_in_omega - st.facet_vertices_in_omega;
   const WorkQueues::Stats& q = queues_.stats();
   for (int i = 0; i < kNumEventTypes; ++i) {
@@ -4259,7 +4227,6 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   if (collars > 0) out->Set("svrc.stitched_arc_crossings", static_cast<double>(stitched_arc_crossings));
   if (collars > 0) out->Set("svrc.stitch_faces_on_plane", static_cast<double>(stitch_faces_on_plane));
   if (collars > 0) out->Set("svrc.stitched_crossings", static_cast<double>(stitched_crossings));
-  if (collars > 0) out->Set("svrc.crossings_at_vertices", static_cast<double>(crossings_at_vertices));
   out->Set("svrc.collar_pairs", static_cast<double>(collar_pairs));
   out->Set("svrc.collar_pairs_not_smooth", static_cast<double>(collar_pairs_not_smooth));
   out->Set("svrc.collar_worst_smoothness", collar_worst_smoothness);

@@ -375,7 +375,6 @@ struct RefineStats {
   uint64_t stitched_arc_crossings = 0;  // arc points for stitched tets crossing a facet inside a collar
   uint64_t stitch_faces_on_plane = 0;   // facet faces with a point of Ω on the plane (stitch_faces_on_plane)
   uint64_t stitched_crossings = 0;      // all points for stitched tets crossing a facet (arc points included)
-  uint64_t crossings_at_vertices = 0;   // facet crossings (rounds and stitch) skipped: an ulp from a vertex of M_F
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   uint64_t slivers_broken = 0;     // kept slivers broken by an insertion at the end (per-tet mode)
   uint64_t sliver_scan_reused = 0; // tets a later BreakSlivers round skipped: an earlier one found them clear

@@ -246,6 +246,38 @@ TEST(BallGridTest, AnswersAsTheScans) {
   EXPECT_LT(inside, total - total / 10);
 }
 
+// SegmentCrossesPlane: points of a slanted plane, constructed in doubles
+// (origin + u·e1 + v·e2, as a facet frame maps its points), are on the plane
+// only up to rounding; a segment from one of them to a point off the plane
+// does not cross it, even for a tolerance far below that rounding (1e-12 of a
+// collar radius of 4.9e-6, random_plcs.py near+rot 9). Segments through the
+// plane do cross, at the point.
+TEST(SegmentCrossesPlaneTest, PointsOfASlantedPlaneUpToRoundingDoNotCross) {
+  const Vec3 origin{0.2504879109722008, 0.2669290550898028, 0.33976598379197998};
+  Vec3 n{0.31, -0.52, 0.79};
+  n = (1 / geom::Norm(n)) * n;
+  Vec3 e1 = geom::Cross(n, Vec3{1, 0, 0});
+  e1 = (1 / geom::Norm(e1)) * e1;
+  const Vec3 e2 = geom::Cross(n, e1);
+  const double rho = 4.8623405968516022e-06;
+  std::mt19937_64 rng(38);
+  std::uniform_real_distribution<double> uni(-rho, rho);
+  int off_plane = 0, crossings = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 p = origin + uni(rng) * e1 + uni(rng) * e2;
+    if (geom::Dot(p - origin, n) != 0) ++off_plane;
+    Vec3 x;
+    for (double side : {0.7, -0.7}) {
+      if (SegmentCrossesPlane(origin, n, p, p + (side * rho) * n, 1e-12 * rho, &x)) ++crossings;
+      if (SegmentCrossesPlane(origin, n, p + (side * rho) * n, p, 1e-12 * rho, &x)) ++crossings;
+    }
+    ASSERT_TRUE(SegmentCrossesPlane(origin, n, p - (0.5 * rho) * n, p + (0.5 * rho) * n, 1e-12 * rho, &x));
+    EXPECT_LT(geom::Dist(x, p), 1e-9 * rho);
+  }
+  EXPECT_GT(off_plane, 1000);  // the rounding this test is about
+  EXPECT_EQ(crossings, 0);
+}
+
 TEST(RepresentationAngleTest, HandChecked) {
   const Vec3 o(0, 0, 0);
   EXPECT_NEAR(RepresentationAngle({0, 0, 1}, {0, 0, 2}, o), 0, 1e-16);
