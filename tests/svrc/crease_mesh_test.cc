@@ -1259,7 +1259,9 @@ TEST(CreaseMesh, NewCollarSpheresKeepOffExistingVertices) {
 // pieces of 1e-16 (INTERNAL "segment 14 piece too short to split"). The
 // crossing test now allows the rounding (SegmentCrossesPlane). ~10 s in
 // release, 524,257 tets.
-constexpr const char* kNearlyTouchingTriangles = R"(14 3 0 0
+
+// random_plcs.py near 9 (LONG_NearlyTouchingTrianglesMesh meshes it in full).
+constexpr const char* kNear9 = R"(14 3 0 0
 1 0 0 0
 2 1 0 0
 3 1 1 0
@@ -1271,9 +1273,9 @@ constexpr const char* kNearlyTouchingTriangles = R"(14 3 0 0
 9 0.6009765408105556 0.5846688586690023 0.42509342901536584
 10 0.3978304341430448 0.631638345599474 0.42508820507821016
 11 0.3807890016592257 0.4864507035226766 0.42509505442050366
-12 0.4212409948353102 0.6863822514724598 0.4251418225629935
-13 0.3362249389217621 0.5150174634395298 0.425123197871335
-14 0.35601659727599466 0.4666016320624646 0.4251817092412936
+12 0.4212409948353102 0.6863822514724598 0.42511762578917967
+13 0.3362249389217621 0.5150174634395298 0.4251083134433504
+14 0.35601659727599466 0.4666016320624646 0.42513756912832973
 8 1
 1 0 1
 4 1 4 3 2
@@ -1299,8 +1301,13 @@ TEST(CreaseMesh, PointsOnAFacetUpToRoundingDoNotCrossIt) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "release only";
 #endif
-  const CreaseMeshed out = MeshPolyTextAndCheck(kNearlyTouchingTriangles, "near_9_gap2.poly",
-                                                "two triangles 4.9e-5 apart");
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcBytes(kNear9, plc::InputFormat::kPoly, "near_9.poly");
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  // The upper triangle (vertices 11–13) twice as far from the lower one's
+  // first vertex's height (bench/svrc/random_plcs.py near 9, gap doubled).
+  const double z0 = plc->vertices[8].z;
+  for (int v = 11; v < 14; ++v) plc->vertices[v].z = z0 + (plc->vertices[v].z - z0) * 2;
+  const CreaseMeshed out = MeshAndCheck(*plc, "two triangles 4.9e-5 apart");
   EXPECT_GT(out.tets, 500000u);
   EXPECT_EQ(out.stats.Get("svrc.stitched_crossings"), 0);
   EXPECT_EQ(out.stats.Get("svrc.collar_snap"), 0);
@@ -1354,41 +1361,6 @@ TEST(CreaseMesh, SliverSequencesKeepTheStitchedDihedralBound) {
 // and the arc points put at those crossings were chased to the resolution of
 // doubles (SegmentCrossesPlane's rounding floor; SegmentCrossesPlaneTest holds
 // the geometry, PointsOnAFacetUpToRoundingDoNotCrossIt a cheaper input).
-constexpr const char* kNear9 = R"(14 3 0 0
-1 0 0 0
-2 1 0 0
-3 1 1 0
-4 0 1 0
-5 0 0 1
-6 1 0 1
-7 1 1 1
-8 0 1 1
-9 0.6009765408105556 0.5846688586690023 0.42509342901536584
-10 0.3978304341430448 0.631638345599474 0.42508820507821016
-11 0.3807890016592257 0.4864507035226766 0.42509505442050366
-12 0.4212409948353102 0.6863822514724598 0.42511762578917967
-13 0.3362249389217621 0.5150174634395298 0.4251083134433504
-14 0.35601659727599466 0.4666016320624646 0.42513756912832973
-8 1
-1 0 1
-4 1 4 3 2
-1 0 1
-4 5 6 7 8
-1 0 1
-4 1 2 6 5
-1 0 1
-4 2 3 7 6
-1 0 1
-4 3 4 8 7
-1 0 1
-4 4 1 5 8
-1 0 3
-3 9 10 11
-1 0 3
-3 12 13 14
-0
-0
-)";
 constexpr const char* kNearRot9 = R"(14 3 0 0
 1 1.1819538239418612 0.011414513475418608 0.7149958240724952
 2 0.37957341022275387 -0.30722139895931444 0.2103604834681735
