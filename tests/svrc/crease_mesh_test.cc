@@ -1250,16 +1250,6 @@ TEST(CreaseMesh, NewCollarSpheresKeepOffExistingVertices) {
   EXPECT_EQ(out.stats.Get("svrc.collar_snap"), 0);
 }
 
-// random_plcs.py near 9 with its gap doubled: two floating triangles 4.9e-5
-// apart over each other, their corners collared (37°–84° corners). Stitched
-// tets' edges from points on the lower triangle's plane up to rounding
-// (1e-17 off it, more than 1e-12 of the 8.9e-6 collar radius) counted as
-// crossing it, and the repair put a point 1.4e-17..4.2e-17 from a vertex of
-// its facet mesh, whose encroachment split segment 14 and the facet down to
-// pieces of 1e-16 (INTERNAL "segment 14 piece too short to split"). The
-// crossing test now allows the rounding (SegmentCrossesPlane). ~10 s in
-// release, 524,257 tets.
-
 // random_plcs.py near 9 (LONG_NearlyTouchingTrianglesMesh meshes it in full).
 constexpr const char* kNear9 = R"(14 3 0 0
 1 0 0 0
@@ -1297,6 +1287,15 @@ constexpr const char* kNear9 = R"(14 3 0 0
 0
 )";
 
+// random_plcs.py near 9 with its gap doubled: two floating triangles 4.9e-5
+// apart over each other, their corners collared (37°–84° corners). Stitched
+// tets' edges from points on the lower triangle's plane up to rounding
+// (1e-17 off it, more than 1e-12 of the 8.9e-6 collar radius) counted as
+// crossing it, and the repair put a point 1.4e-17..4.2e-17 from a vertex of
+// its facet mesh, whose encroachment split segment 14 and the facet down to
+// pieces of 1e-16 (INTERNAL "segment 14 piece too short to split"). The
+// crossing test now allows the rounding (SegmentCrossesPlane). ~10 s in
+// release, 524,257 tets.
 TEST(CreaseMesh, PointsOnAFacetUpToRoundingDoNotCrossIt) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   GTEST_SKIP() << "release only";
