@@ -24,6 +24,9 @@ with repr, so they round-trip). Kinds (all inside or on the unit box):
 KIND+rot (e.g. prism+rot) is KIND's PLC turned by a random rotation about
 the box's centre (session 38): every facet is then slanted, its points
 coplanar only up to rounding.
+KIND+far (also KIND+rot+far) moves it far from the origin: scaled by 1e-2
+about the box's centre and translated by (12345.678, -9876.54, 4321.0), so
+its coordinates carry ~1e-12 of rounding on a model of size 1e-2.
 Some outputs are invalid PLCs (intersecting features); the sweep validates
 first and skips them.
 """
@@ -452,13 +455,26 @@ def rotate_plc(rng, nodes, facets, holes=(), regions=()):
     regions = [rot(r[:3]) + tuple(r[3:]) for r in regions]
     return nodes, facets, holes, regions
 
+def move_far(nodes, facets, holes=(), regions=()):
+    s, t = 1e-2, (12345.678, -9876.54, 4321.0)
+    def mv(p):
+        return tuple(t[k] + s * (p[k] - 0.5) for k in range(3))
+    nodes = [mv(p) for p in nodes]
+    facets = [(f[0], f[1], [mv(h) for h in f[2]]) if len(f) > 2 else f for f in facets]
+    holes = [mv(h) for h in holes]
+    regions = [mv(r[:3]) + (r[3], r[4] * s ** 3 if r[4] > 0 else r[4]) + tuple(r[5:]) for r in regions]
+    return nodes, facets, holes, regions
+
 if __name__ == '__main__':
     kind, seed, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-    base, rotated = (kind[:-4], True) if kind.endswith('+rot') else (kind, False)
+    parts = kind.split('+')
+    base, mods = parts[0], parts[1:]
     rng = random.Random(seed * 1000 + list(GENS).index(base))
     r = None
     while r is None:
         r = GENS[base](rng)
-    if rotated:
+    if 'rot' in mods:
         r = rotate_plc(random.Random(seed * 1000 + 999), *r)
+    if 'far' in mods:
+        r = move_far(*r)
     write_poly(out, *r)

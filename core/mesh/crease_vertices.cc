@@ -1,10 +1,12 @@
 #include "core/mesh/crease_vertices.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
 
 #include "absl/status/statusor.h"
+#include "core/mesh/conformity.h"
 #include "core/plc/validate.h"
 
 namespace svrc::mesh {
@@ -46,6 +48,7 @@ std::vector<uint8_t> CreaseVertexFlags(const plc::Plc& plc, const TetMesh& mesh)
       }
     }
   }
+  const double on_feature_tol = OnFeatureTolerance(plc.vertices);
   for (const plc::FeatureSegment& s : c->segments) {
     if (!s.crease) continue;
     const geom::Vec3 a = c->points[s.a].p, b = c->points[s.b].p;
@@ -54,7 +57,12 @@ std::vector<uint8_t> CreaseVertexFlags(const plc::Plc& plc, const TetMesh& mesh)
     if (ia == crease_point.end() || ib == crease_point.end() || ia->second == kNone || ib->second == kNone) continue;
     const geom::Vec3 d = b - a;
     const double dd = geom::Dot(d, d);
-    const double tol = 1e-12 * std::sqrt(dd);
+    // A chain vertex is on the segment up to rounding: relative to its
+    // length, or the conformity checker's on-feature tolerance when that is
+    // larger (random_plcs.py hull+far 2: coordinates ~1.2e4, a segment of
+    // 1e-2, a chain vertex 9.1e-13 off it; the walk stopped there and the
+    // tets past it counted as away from the creases).
+    const double tol = std::max(1e-12 * std::sqrt(dd), on_feature_tol);
     uint32_t v = ia->second;
     double tv = 0;
     while (v != ib->second) {

@@ -1404,5 +1404,64 @@ TEST(CreaseMesh, LONG_NearlyTouchingTrianglesMesh) {
   EXPECT_GT(MeshPolyTextAndCheck(kNearRot9, "near_rot_9.poly", "near+rot 9").tets, 1000000u);
 }
 
+// random_plcs.py hull+far 2: a random convex hull (creases down to a few
+// degrees, 57 collars) of size 1e-2 at coordinates ~1.2e4, where rounding is
+// 1.8e-12. Two tolerances were relative only: the conformity checker wanted
+// each facet covered to 1e-9 of its area (facet 12 came out 3.0e-16 = 1.3e-9
+// short: its boundary vertices are on the segments up to rounding), so the
+// collar path refused its own stitched mesh; and CreaseVertexFlags wanted
+// chain vertices within 1e-12 of a segment's length (1e-14) of it, so the
+// walk stopped at one 9.1e-13 off and tets of radius-edge 264.7 touching
+// crease vertices past it counted as away from the creases. Both now allow
+// the checker's on-feature tolerance. ~3 s.
+constexpr const char* kFarHull2 = R"(9 3 0 0
+1 12345.673712170723 -9876.535889114512 4320.998230779145
+2 12345.678617811729 -9876.544313450706 4320.997462801055
+3 12345.677431974016 -9876.543093033048 4321.000612580474
+4 12345.680777677062 -9876.542994587511 4321.001824824741
+5 12345.67511318317 -9876.541824036276 4320.998656338524
+6 12345.681018450192 -9876.543266562641 4321.001543661196
+7 12345.680556296023 -9876.538281696156 4321.000957187759
+8 12345.674966420404 -9876.54396478134 4320.996063899246
+9 12345.67905508489 -9876.539732222638 4321.004055772204
+14 1
+1 0 1
+3 4 3 6
+1 0 1
+3 3 2 6
+1 0 1
+3 2 1 7
+1 0 1
+3 6 2 7
+1 0 1
+3 1 2 8
+1 0 1
+3 5 1 8
+1 0 1
+3 2 3 8
+1 0 1
+3 3 5 8
+1 0 1
+3 3 4 9
+1 0 1
+3 1 5 9
+1 0 1
+3 5 3 9
+1 0 1
+3 7 1 9
+1 0 1
+3 4 6 9
+1 0 1
+3 6 7 9
+0
+0
+)";
+
+TEST(CreaseMesh, FarFromTheOriginMeshesAndChecks) {
+  const CreaseMeshed out = MeshPolyTextAndCheck(kFarHull2, "hull_far_2.poly", "hull+far 2");
+  EXPECT_GT(out.tets, 10000u);
+  EXPECT_GT(out.stats.Get("svrc.collars"), 0);
+}
+
 }  // namespace
 }  // namespace svrc
