@@ -836,37 +836,29 @@ class Preparer {
     return false;
   }
 
-  bool SegSegImproper(SegmentId i, SegmentId j) const {
+  // Do segments i and j meet other than at a shared endpoint? Exactly in 3D
+  // (drop < 0), or in the projection dropping axis `drop` for edges of one
+  // facet: a slanted facet's points are coplanar only up to rounding, and
+  // the 3D test needs exact coplanarity (random_plcs.py holed 85: a hole loop
+  // crossing the outer loop of a slanted facet was VALID).
+  bool SegSegImproper(SegmentId i, SegmentId j, int drop = -1) const {
     const FeatureSegment& s = fc_.segments[i];
     const FeatureSegment& t = fc_.segments[j];
     PointId v = kNoId, a = kNoId, b = kNoId;
     if (s.a == t.a || s.a == t.b) v = s.a, a = s.b, b = s.a == t.a ? t.b : t.a;
     else if (s.b == t.a || s.b == t.b) v = s.b, a = s.a, b = s.b == t.a ? t.b : t.a;
-    if (v == kNoId) return SegmentsMeet(P_[s.a], P_[s.b], P_[t.a], P_[t.b]);
-    if (!Collinear(P_[v], P_[a], P_[b])) return false;
+    if (v == kNoId) {
+      return drop < 0 ? SegmentsMeet(P_[s.a], P_[s.b], P_[t.a], P_[t.b])
+                      : SegmentsMeetProjected(P_[s.a], P_[s.b], P_[t.a], P_[t.b], drop);
+    }
+    if (drop < 0 ? !Collinear(P_[v], P_[a], P_[b]) : Orient2dSign(P_[v], P_[a], P_[b], drop) != 0) return false;
+    // Collinear: they overlap iff a and b are on one side of v, along the
+    // largest coordinate of a − v that is kept.
     const Vec3 e = P_[a] - P_[v];
-    const int k = std::fabs(e.x) >= std::fabs(e.y) && std::fabs(e.x) >= std::fabs(e.z) ? 0 : (std::fabs(e.y) >= std::fabs(e.z) ? 1 : 2);
-    return (P_[a][k] > P_[v][k]) == (P_[b][k] > P_[v][k]);
-  }
-
-  // Do edges i and j of facet f cross or overlap (other than at a shared
-  // endpoint)? Decided in f's projection: a slanted facet's points are
-  // coplanar only up to rounding, and the 3D test (SegSegImproper) needs
-  // exact coplanarity (random_plcs.py holed 85: a hole loop crossing the
-  // outer loop of a slanted facet was VALID).
-  bool FacetSegSegImproper(SegmentId i, SegmentId j, FacetId f) const {
-    const int drop = work_[f].drop;
-    const FeatureSegment& s = fc_.segments[i];
-    const FeatureSegment& t = fc_.segments[j];
-    PointId v = kNoId, a = kNoId, b = kNoId;
-    if (s.a == t.a || s.a == t.b) v = s.a, a = s.b, b = s.a == t.a ? t.b : t.a;
-    else if (s.b == t.a || s.b == t.b) v = s.b, a = s.a, b = s.b == t.a ? t.b : t.a;
-    if (v == kNoId) return SegmentsMeetProjected(P_[s.a], P_[s.b], P_[t.a], P_[t.b], drop);
-    if (Orient2dSign(P_[v], P_[a], P_[b], drop) != 0) return false;
-    // Collinear in the projection: they overlap iff a and b are on one side of v.
-    const int i2 = (drop + 1) % 3, j2 = (drop + 2) % 3;
-    const Vec3 e = P_[a] - P_[v];
-    const int k = std::fabs(e[i2]) >= std::fabs(e[j2]) ? i2 : j2;
+    int k = -1;
+    for (int c = 0; c < 3; ++c) {
+      if (c != drop && (k < 0 || std::fabs(e[c]) > std::fabs(e[k]))) k = c;
+    }
     return (P_[a][k] > P_[v][k]) == (P_[b][k] > P_[v][k]);
   }
 
@@ -923,7 +915,7 @@ class Preparer {
         // (reported below); edges of one facet are this test's own finding.
         for (FacetId f : fa) {
           if (several_loops(f) && std::find(fb.begin(), fb.end(), f) != fb.end() &&
-              FacetSegSegImproper(a.index, b.index, f)) {
+              SegSegImproper(a.index, b.index, work_[f].drop)) {
             crossed_facets.insert(f);
           }
         }
