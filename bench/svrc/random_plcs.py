@@ -444,26 +444,25 @@ def random_rotation(rng):
             [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
 
-def rotate_plc(rng, nodes, facets, holes=(), regions=()):
+def map_plc(point, volume_factor, nodes, facets, holes=(), regions=()):
+    """The PLC with every point (nodes, facet holes, holes, region seeds) mapped by `point`
+    and region max volumes multiplied by volume_factor."""
+    nodes = [point(p) for p in nodes]
+    facets = [(f[0], f[1], [point(h) for h in f[2]]) if len(f) > 2 else f for f in facets]
+    holes = [point(h) for h in holes]
+    regions = [point(r[:3]) + (r[3], r[4] * volume_factor if r[4] > 0 else r[4]) + tuple(r[5:]) for r in regions]
+    return nodes, facets, holes, regions
+
+def rotate_plc(rng, *plc):
     m = random_rotation(rng)
     def rot(p):
         d = [p[k] - 0.5 for k in range(3)]
         return tuple(0.5 + sum(m[i][k] * d[k] for k in range(3)) for i in range(3))
-    nodes = [rot(p) for p in nodes]
-    facets = [(f[0], f[1], [rot(h) for h in f[2]]) if len(f) > 2 else f for f in facets]
-    holes = [rot(h) for h in holes]
-    regions = [rot(r[:3]) + tuple(r[3:]) for r in regions]
-    return nodes, facets, holes, regions
+    return map_plc(rot, 1, *plc)
 
-def move_far(nodes, facets, holes=(), regions=()):
+def move_far(*plc):
     s, t = 1e-2, (12345.678, -9876.54, 4321.0)
-    def mv(p):
-        return tuple(t[k] + s * (p[k] - 0.5) for k in range(3))
-    nodes = [mv(p) for p in nodes]
-    facets = [(f[0], f[1], [mv(h) for h in f[2]]) if len(f) > 2 else f for f in facets]
-    holes = [mv(h) for h in holes]
-    regions = [mv(r[:3]) + (r[3], r[4] * s ** 3 if r[4] > 0 else r[4]) + tuple(r[5:]) for r in regions]
-    return nodes, facets, holes, regions
+    return map_plc(lambda p: tuple(t[k] + s * (p[k] - 0.5) for k in range(3)), s ** 3, *plc)
 
 if __name__ == '__main__':
     kind, seed, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
