@@ -149,6 +149,12 @@ std::vector<uint32_t> FirstOccurrences(const std::vector<Vec3>& pts) {
 
 // ------------------------------------------------------------- facet model
 
+// A facet whose vertices are farther than this fraction of its diameter from
+// the plane through three of them is not planar. Validation allows 1e-8 of the
+// diameter from its Newell plane (plc::ValidationOptions::planarity_tolerance);
+// the plane through three vertices can be twice as far from the others.
+constexpr double kFacetFlatnessRel = 2e-8;
+
 struct Plane {
   Vec3 a, b, c;  // three input points, not collinear
   Vec3 n;        // unit normal (floating point, for tolerances and areas)
@@ -171,6 +177,13 @@ struct FacetGeom {
   double area = 0;
   double perimeter = 0;  // of all its loops
   Box3 box;
+  // Distance within which a point counts as on the facet: the checker's
+  // on-feature tolerance, or 4x the facet's own flatness (its vertices'
+  // largest distance from `plane`) when that is larger. Validation accepts
+  // facets planar to 1e-8 of their diameter (docs/plc.md); a mesher puts a
+  // facet's Steiner points on some plane through it, within flatness of the
+  // vertices at both ends: up to ~4x the flatness from `plane` (docs/conformity.md).
+  double tol = 0;
   int32_t marker = 0;
 };
 
@@ -290,9 +303,11 @@ FacetGeom BuildFacet(const plc::Plc& plc, const plc::Facet& facet,
   const Vec3 n = Cross(b - a, c - a);
   f.plane.n = n / Norm(n);
   f.plane.axis = geom::DominantAxis(n);
-  for (uint32_t v : all) {
-    if (SideOf(f.plane, plc.vertices[v], tol) != 0) return f;  // not planar
-  }
+  double flat = 0;
+  for (uint32_t v : all) flat = std::max(flat, std::fabs(Dot(f.plane.n, plc.vertices[v] - a)));
+  const double diameter = Norm(f.box.hi - f.box.lo);
+  if (flat > tol && flat > kFacetFlatnessRel * diameter) return f;  // not planar
+  f.tol = std::max(tol, 4 * flat);
   for (const auto& poly : facet.polygons) {
     if (poly.vertices.size() < 3) continue;
     Loop l;
@@ -650,7 +665,7 @@ class Checker {
     }
     all = Expand(all, tol_);
     facet_grid_ = std::make_unique<BoxGrid>(all, facets_.size(), 1, 64, [&](size_t i) {
-      return facets_[i].valid ? Expand(facets_[i].box, tol_) : Box3();
+      return facets_[i].valid ? Expand(facets_[i].box, facets_[i].tol) : Box3();
     });
     facet_stamp_.assign(facets_.size(), kNone);
     region_.resize(facets_.size());
@@ -668,8 +683,8 @@ class Checker {
       if (facet_stamp_[i] == query_) return;
       facet_stamp_[i] = query_;
       const FacetGeom& fg = facets_[i];
-      if (SideOf(fg.plane, a, tol_) != 0 || SideOf(fg.plane, b, tol_) != 0 ||
-          SideOf(fg.plane, c, tol_) != 0) {
+      if (SideOf(fg.plane, a, fg.tol) != 0 || SideOf(fg.plane, b, fg.tol) != 0 ||
+          SideOf(fg.plane, c, fg.tol) != 0) {
         return;
       }
       // The centroid is rounded; project it onto the plane's coordinates by
@@ -707,6 +722,19 @@ class Checker {
   // closed, consistently orientable 2-manifold surfaces (no internal facets);
   // nested surfaces and volume holes are resolved by winding numbers
   // (docs/conformity.md).
+  // The volume by which a mesh whose facet triangles are within each facet's
+  // tolerance of it may differ from the volumes the facets enclose: the sum
+  // of area x tolerance. Negligible for planar facets (8 ulps); a facet
+  // planar to 1e-9 of its size moves Steiner points that far (a unit cube
+  // with one vertex 9e-9 off its face's plane: cell volume 1.2e-9 over).
+  double FlatnessVolume() const {
+    double v = 0;
+    for (const FacetGeom& fg : facets_) {
+      if (fg.valid) v += fg.area * fg.tol;
+    }
+    return v;
+  }
+
   void CheckVolume() {
     if (opt_.keep_bounding_box) {
       if (!mesh_box_.Empty()) {
@@ -726,7 +754,7 @@ class Checker {
     // total is the fallback when a component could not be located.
     if (cells_known_ && CheckCellCoverage()) return;
     const double ve = rep_->enclosed_volume, vm = rep_->mesh_volume;
-    if (std::fabs(vm - ve) > opt_.volume_rel_tol * std::fabs(ve)) {
+    if (std::fabs(vm - ve) > std::max(opt_.volume_rel_tol * std::fabs(ve), FlatnessVolume())) {
       Add(rep_, opt_, ViolationKind::kVolumeMismatch, {},
           absl::StrFormat("total tet volume %.17g != enclosed volume %.17g (relative %.3g)", vm,
                           ve, std::fabs(vm - ve) / std::max(std::fabs(ve), 1e-300)));
@@ -1101,7 +1129,7 @@ class Checker {
         facet_stamp_[g] = query_;
         if (std::binary_search(bnd[g].begin(), bnd[g].end(), e)) return;
         const FacetGeom& gg = facets_[g];
-        if (SideOf(gg.plane, pv[a], tol_) != 0 || SideOf(gg.plane, pv[b], tol_) != 0) return;
+        if (SideOf(gg.plane, pv[a], gg.tol) != 0 || SideOf(gg.plane, pv[b], gg.tol) != 0) return;
         if (!InFacetRegion(gg, mid) || !InFacetRegion(gg, pv[a]) || !InFacetRegion(gg, pv[b])) {
           return;
         }
@@ -1376,7 +1404,7 @@ class Checker {
       q.Add(P(static_cast<uint32_t>(v)));
       facet_grid_->Query(q, [&](uint32_t f) {
         if (!on_plane[v] && facets_[f].valid &&
-            SideOf(facets_[f].plane, P(static_cast<uint32_t>(v)), tol_) == 0) {
+            SideOf(facets_[f].plane, P(static_cast<uint32_t>(v)), facets_[f].tol) == 0) {
           on_plane[v] = 1;
         }
       });
@@ -1431,7 +1459,9 @@ class Checker {
     for (int32_t c = 0; c <= num_bounded_cells_; ++c) {
       const bool meshed = !cell_hole_[c];
       const double want = meshed ? cell_volume_[c] : 0;
-      if (std::fabs(cell_mesh[c] - want) <= opt_.volume_rel_tol * std::max(want, scale)) continue;
+      if (std::fabs(cell_mesh[c] - want) <= std::max(opt_.volume_rel_tol * std::max(want, scale), FlatnessVolume())) {
+        continue;
+      }
       std::string seeds;
       for (size_t r = 0; r < plc_->regions.size(); ++r) {
         if (LocateCell(plc_->regions[r].point) == c) absl::StrAppend(&seeds, " ", r);
@@ -1628,13 +1658,13 @@ class Checker {
         ++rep_->num_facets_outside;
         continue;
       }
-      // Mesh vertices on the facet's boundary are on it within tol_ (the
-      // on-feature tolerance), so the covered area may differ from the
-      // facet's by up to its perimeter times tol_ without a gap; far from
+      // Mesh vertices on the facet's boundary are on it within its tolerance
+      // (FacetGeom::tol), so the covered area may differ from the
+      // facet's by up to its perimeter times that without a gap; far from
       // the origin that exceeds area_rel_tol (random_plcs.py hull+far 2: a
       // facet of area 2.2e-7 at coordinates ~1.2e4, 3.0e-16 short = 1.3e-9 of
       // it, with tol_ = 2.1e-11 and a perimeter of 2.6e-3).
-      if (std::fabs(covered[f] - want) > std::max(opt_.area_rel_tol * want, facets_[f].perimeter * tol_)) {
+      if (std::fabs(covered[f] - want) > std::max(opt_.area_rel_tol * want, facets_[f].perimeter * facets_[f].tol)) {
         Add(rep_, opt_, ViolationKind::kFacetNotCovered, {static_cast<int64_t>(f)},
             absl::StrFormat("facet %d: mesh triangles on it cover area %.17g, facet area %.17g", f,
                             covered[f], want));
@@ -1661,16 +1691,16 @@ class Checker {
     if (mesh_box_.Empty() || mesh_.tets.empty()) return false;
     const FacetGeom& fg = facets_[f];
     bool found = false;
-    TetGrid().Query(Expand(fg.box, tol_), [&](uint32_t t) {
+    TetGrid().Query(Expand(fg.box, fg.tol), [&](uint32_t t) {
       if (found || !tet_ok_[t]) return;
       const auto& q = mesh_.tets[t];
       int on = 0;
-      for (int i = 0; i < 4; ++i) on += SideOf(fg.plane, P(q[i]), tol_) == 0 ? 1 : 0;
+      for (int i = 0; i < 4; ++i) on += SideOf(fg.plane, P(q[i]), fg.tol) == 0 ? 1 : 0;
       if (on < 3) return;
       for (const auto& face : kFace) {
         const Vec3 &a = P(q[face[0]]), &b = P(q[face[1]]), &c = P(q[face[2]]);
-        if (SideOf(fg.plane, a, tol_) == 0 && SideOf(fg.plane, b, tol_) == 0 &&
-            SideOf(fg.plane, c, tol_) == 0 && InFacetRegion(fg, (a + b + c) / 3.0)) {
+        if (SideOf(fg.plane, a, fg.tol) == 0 && SideOf(fg.plane, b, fg.tol) == 0 &&
+            SideOf(fg.plane, c, fg.tol) == 0 && InFacetRegion(fg, (a + b + c) / 3.0)) {
           found = true;
           return;
         }
@@ -1727,10 +1757,10 @@ class Checker {
       for (uint32_t v : t) b.Add(pv[v]);
       rm.tris.push_back(t);
       rm.orient.push_back(static_cast<int8_t>(o));
-      rm.boxes.push_back(Expand(b, tol_));
+      rm.boxes.push_back(Expand(b, fg.tol));
     }
     if (rm.tris.size() > 16) {
-      rm.grid = std::make_unique<BoxGrid>(Expand(fg.box, tol_), rm.tris.size(), 2, 64,
+      rm.grid = std::make_unique<BoxGrid>(Expand(fg.box, fg.tol), rm.tris.size(), 2, 64,
                                           [&](size_t i) { return rm.boxes[i]; });
       rm.stamp.assign(rm.tris.size(), kNone);
     }
@@ -1758,11 +1788,11 @@ class Checker {
   // to the line p->r of facet plane pl, in the projection dropping pl.axis;
   // nsign = sign of the plane normal's axis component.
   int SectionSide(const std::array<uint32_t, 4>& q, const SectionPoint& s, const Vec3& p,
-                  const Vec3& r, int axis, int nsign) const {
+                  const Vec3& r, int axis, int nsign, double tol) const {
     if (s.j < 0) {
       const Vec3& o = P(q[s.i]);
       const int side = geom::Orient2dProjected(p, r, o, axis);
-      if (side != 0 && tol_ > 0 && DistToLine(p, r, o) <= tol_) return 0;
+      if (side != 0 && tol > 0 && DistToLine(p, r, o) <= tol) return 0;
       return side;
     }
     return -geom::Orient3d(p, r, P(q[s.i]), P(q[s.j])) * nsign;
@@ -1795,7 +1825,7 @@ class Checker {
         const Vec3 &a = pv[t[e]], &b = pv[t[(e + 1) % 3]];
         bool out = true;
         for (int m = 0; m < ns && out; ++m) {
-          out = SectionSide(q, sec[m], a, b, axis, nsign) * rm.orient[k] <= 0;
+          out = SectionSide(q, sec[m], a, b, axis, nsign, fg.tol) * rm.orient[k] <= 0;
         }
         if (out) return true;
       }
@@ -1806,7 +1836,7 @@ class Checker {
         for (int m = 0; m < 3 && out; ++m) {
           const Vec3& x = pv[t[m]];
           const int o = geom::Orient3d(a, b, c, x);
-          out = o != inner || (tol_ > 0 && DistToPlane(a, b, c, x) <= tol_);
+          out = o != inner || (fg.tol > 0 && DistToPlane(a, b, c, x) <= fg.tol);
         }
         if (out) return true;
       }
@@ -1888,14 +1918,14 @@ class Checker {
       const int nsign = geom::Orient2dProjected(fg.plane.a, fg.plane.b, fg.plane.c, axis);
       RegionMesh* rm = nullptr;  // built on the first candidate tet
       std::vector<std::vector<P2>> loops2;  // for the fallback only
-      tet_grid.Query(Expand(fg.box, tol_), [&](uint32_t t) {
+      tet_grid.Query(Expand(fg.box, fg.tol), [&](uint32_t t) {
         if (stamp[t] == f) return;
         stamp[t] = static_cast<uint32_t>(f);
         const auto& q = mesh_.tets[t];
         int side[4];
         bool pos = false, neg = false;
         for (int i = 0; i < 4; ++i) {
-          side[i] = SideOf(fg.plane, P(q[i]), tol_);
+          side[i] = SideOf(fg.plane, P(q[i]), fg.tol);
           pos = pos || side[i] > 0;
           neg = neg || side[i] < 0;
         }

@@ -639,6 +639,11 @@ class Refiner {
   // The conformity checker's on-plane tolerance (mesh::OnFeatureTolerance)
   // in normalised coordinates.
   double on_plane_tol_ = 0;
+  // Per facet: the largest distance of its input points from its frame's
+  // plane (normalised). Validation accepts facets planar to 1e-8 of their
+  // diameter (docs/plc.md); a slanted facet far from the origin is planar only
+  // to the rounding of its input coordinates, which the normalisation keeps.
+  std::vector<double> facet_flatness_;
   uint32_t facet_mesh0_ = 0;             // MeshId of facet 0 (= its FeatureId)
   std::vector<std::vector<uint32_t>> point_facets_;  // per complex point: facets containing it
   std::vector<std::vector<uint32_t>> seg_facets_;    // per segment: facets containing it
@@ -948,9 +953,12 @@ absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const 
       const PointId c = points_.Add(frame.ToSpace(facets_.back().QuadCorner(i)), features_.OfFacet(f), kCdFacet);
       points_.SetVertex(c, FacetMeshId(f), i);
     }
+    double flat = 0;
     for (PointId p : facets_.back().region().all_points) {
       if (p.value() < num_input_) point_facets_[p.value()].push_back(f);
+      flat = std::max(flat, std::fabs(geom::Dot(points_.Xyz(p) - frame.origin, frame.normal)));
     }
+    facet_flatness_.push_back(flat);
   }
 
   // Figure 3.3: UpdateLocation(∅, M_F, F) for every feature, lowest dimension
@@ -2738,7 +2746,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
           const Vec3& pa = dt.Point(t.v[k]);
           const Vec3& pb = dt.Point(t.v[(k + 1) % 3]);
           Vec3 x;
-          if (!CrossesPlane(fr, pa, pb, 1e-12 * ball.radius, &x)) continue;
+          if (!CrossesPlane(fr, pa, pb, std::max(1e-12 * ball.radius, 2 * facet_flatness_[f]), &x)) continue;
           Vec2 q;
           if (!NearestArcPoint(fr, ball, fr.ToPlane(x), &q)) continue;
           if (facets_[f].region().Locate(q) == FacetRegion::Where::kOutside) continue;
@@ -2951,7 +2959,9 @@ std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacet
     const Vec3& x = points_.Xyz(PointId(k[2]));
     for (uint32_t f : fa) {
       const plc::FacetFrame& fr = frames_[f];
-      if (!(std::fabs(geom::Dot(x - fr.origin, fr.normal)) <= on_plane_tol_)) continue;
+      if (!(std::fabs(geom::Dot(x - fr.origin, fr.normal)) <= std::max(on_plane_tol_, 2 * facet_flatness_[f]))) {
+        continue;
+      }
       if (!CentroidInRegion(f, Uv(f, on[0]), Uv(f, on[1]), fr.ToPlane(x))) continue;
       std::array<uint32_t, 3> sorted = k;
       std::sort(sorted.begin(), sorted.end());
@@ -3005,7 +3015,9 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
           const Vec3& pa = points_.Xyz(PointId(ia));
           const Vec3& pb = points_.Xyz(PointId(ib));
           Vec3 x;
-          if (!CrossesPlane(fr, pa, pb, 1e-12 * collars_.ball(bi).radius, &x)) continue;
+          if (!CrossesPlane(fr, pa, pb, std::max(1e-12 * collars_.ball(bi).radius, 2 * facet_flatness_[f]), &x)) {
+            continue;
+          }
           Vec2 uv = fr.ToPlane(x);
           const uint32_t in = collars_.FindContaining(x);
           if (in != CollarIndex::kNone) {

@@ -184,6 +184,45 @@ TEST(Conformity, RejectsDeletedOnlyTet) {
   EXPECT_EQ(r.Count(ViolationKind::kVolumeMismatch), 1u) << r.Summary();
 }
 
+// Validation accepts a facet planar to 1e-8 of its diameter (docs/plc.md); the
+// checker took such a facet as not planar beyond 8 ulps, and refused the
+// mesher's output for a unit cube with a corner 9e-9 above its top face
+// (session 39). A facet's points now count as on it within 4x its flatness;
+// a Steiner point off it by more, or a facet bent beyond what validation
+// accepts, is still refused.
+TEST(Conformity, FacetPlanarToTheValidationToleranceUsesItsFlatness) {
+  const double bend = 9e-9;
+  plc::Plc p = BoxPlc(kLo, kHi);
+  TetMesh m = KuhnBoxMesh(p, 2);
+  auto corner = std::find(p.vertices.begin(), p.vertices.end(), Vec3(1, 1, 1));
+  ASSERT_NE(corner, p.vertices.end());
+  auto mcorner = std::find(m.positions.begin(), m.positions.end(), Vec3(1, 1, 1));
+  ASSERT_NE(mcorner, m.positions.end());
+  auto centre = std::find(m.positions.begin(), m.positions.end(), Vec3(0.5, 0.5, 1));
+  ASSERT_NE(centre, m.positions.end());
+  corner->z += bend;
+  mcorner->z += bend;
+  // The midpoints of the two top edges at that corner follow their edges.
+  for (const Vec3& mid : {Vec3(1, 0.5, 1), Vec3(0.5, 1, 1)}) {
+    auto it = std::find(m.positions.begin(), m.positions.end(), mid);
+    ASSERT_NE(it, m.positions.end());
+    it->z += bend / 2;
+  }
+  const ConformityReport ok = CheckConformity(p, m);
+  EXPECT_TRUE(ok.ok()) << ok.Summary();
+  // The top face's centre 1e-7 off its plane: beyond 4 x 9e-9.
+  TetMesh off = m;
+  off.positions[centre - m.positions.begin()].z -= 1e-7;
+  const ConformityReport r = CheckConformity(p, off);
+  EXPECT_GT(r.Count(ViolationKind::kTriangleOffFacet), 0u) << r.Summary();
+  // A corner 1e-6 off: the facet is not planar (validation refuses it too).
+  plc::Plc bent = p;
+  TetMesh mbent = m;
+  bent.vertices[corner - p.vertices.begin()].z += 1e-6;
+  mbent.positions[mcorner - m.positions.begin()].z += 1e-6;
+  EXPECT_FALSE(CheckConformity(bent, mbent).ok());
+}
+
 TEST(Conformity, RejectsVertexMovedOffItsFacet) {
   const plc::Plc p = BoxPlc(kLo, kHi);
   for (double delta : {1e-3, 1e-12}) {

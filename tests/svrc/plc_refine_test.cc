@@ -82,6 +82,31 @@ TEST(PlcRefine, FarOffsetClosePoints) {
   ExpectGoodMesh(m, 2.0, "far_offset_close_points");
 }
 
+// A unit cube with its corner (1,1,1) 9e-9 above the top face's plane:
+// validation accepts facets planar to 1e-8 of their diameter (TetGen's -T
+// default), and the mesher meshes it, but the checker refused the output,
+// (session 39: "face ... is in no other tet and on no input facet" without
+// max_volume, the cell's volume 1.2e-9 over with it): it took a facet as
+// planar only to 8 ulps. It now allows 4x the facet's flatness.
+TEST(PlcRefine, FacetPlanarToTheValidationToleranceMeshes) {
+  absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath("a_convex/cube.poly"));
+  ASSERT_TRUE(plc.ok()) << plc.status();
+  Meshed m;
+  m.plc = *plc;
+  auto corner = std::find(m.plc.vertices.begin(), m.plc.vertices.end(), geom::Vec3(1, 1, 1));
+  ASSERT_NE(corner, m.plc.vertices.end());
+  corner->z += 9e-9;
+  ASSERT_TRUE(plc::ValidatePlc(m.plc).ok()) << plc::ValidatePlc(m.plc).ToStatus();
+  for (double max_volume : {0.0, 1e-3}) {
+    core::MeshParams params;
+    params.max_volume = max_volume;
+    absl::StatusOr<mesh::TetMesh> out = core::MeshPlc(m.plc, params);
+    ASSERT_TRUE(out.ok()) << out.status();
+    m.mesh = std::move(*out);
+    ExpectGoodMesh(m, 2.0, absl::StrCat("bent cube, max_volume ", max_volume));
+  }
+}
+
 // Creased corpus inputs (tetra.poly's base angles are ~55°; example.poly has
 // collars' creases below 45°) mesh and pass the checker; the sharp-crease
 // inputs and the collar stage are covered by crease_mesh_test.cc.
