@@ -27,6 +27,10 @@ coplanar only up to rounding.
 KIND+far (also KIND+rot+far) moves it far from the origin: scaled by 1e-2
 about the box's centre and translated by (12345.678, -9876.54, 4321.0), so
 its coordinates carry ~1e-12 of rounding on a model of size 1e-2.
+KIND+bend (before +rot and +far) moves every node by a random vector of
+length up to 2e-9 of the smallest facet containing it (session 39): facets
+planar only to ~4e-9 of their diameter, which validation accepts (TetGen's
+-T 1e-8), and points near but no longer exactly on other facets' edges.
 Some outputs are invalid PLCs (intersecting features); the sweep validates
 first and skips them.
 """
@@ -460,6 +464,23 @@ def rotate_plc(rng, *plc):
         return tuple(0.5 + sum(m[i][k] * d[k] for k in range(3)) for i in range(3))
     return map_plc(rot, 1, *plc)
 
+def bend_plc(rng, nodes, facets, holes=(), regions=()):
+    size = [1.0] * len(nodes)
+    for f in facets:
+        ids = [v for poly in f[0] for v in poly]
+        lo = [min(nodes[v][k] for v in ids) for k in range(3)]
+        hi = [max(nodes[v][k] for v in ids) for k in range(3)]
+        d = math.sqrt(sum((hi[k] - lo[k]) ** 2 for k in range(3)))
+        for v in ids:
+            size[v] = min(size[v], d)
+    out = []
+    for p, d in zip(nodes, size):
+        u = [rng.gauss(0, 1) for _ in range(3)]
+        n = math.sqrt(sum(x * x for x in u)) or 1.0
+        a = 2e-9 * d * rng.random()
+        out.append(tuple(p[k] + a * u[k] / n for k in range(3)))
+    return out, facets, holes, regions
+
 def move_far(*plc):
     s, t = 1e-2, (12345.678, -9876.54, 4321.0)
     return map_plc(lambda p: tuple(t[k] + s * (p[k] - 0.5) for k in range(3)), s ** 3, *plc)
@@ -472,6 +493,8 @@ if __name__ == '__main__':
     r = None
     while r is None:
         r = GENS[base](rng)
+    if 'bend' in mods:
+        r = bend_plc(random.Random(seed * 1000 + 998), *r)
     if 'rot' in mods:
         r = rotate_plc(random.Random(seed * 1000 + 999), *r)
     if 'far' in mods:

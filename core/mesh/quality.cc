@@ -98,6 +98,31 @@ Distribution Distribution::Of(std::vector<double> values) {
   return d;
 }
 
+double MaxDihedralLessRounding(const TetMesh& mesh, const std::vector<uint8_t>& flagged_vertex) {
+  if (flagged_vertex.size() != mesh.positions.size()) return 0;
+  double worst = 0;
+  for (const auto& t : mesh.tets) {
+    bool touches = false;
+    for (uint32_t v : t) touches = touches || flagged_vertex[v] != 0;
+    if (!touches) continue;
+    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]],
+               &d = mesh.positions[t[3]];
+    const TetQuality q = ComputeTetQuality(a, b, c, d);
+    double scale = 0, max_face = 0;
+    for (const Vec3* p : {&a, &b, &c, &d}) {
+      scale = std::max({scale, std::fabs(p->x), std::fabs(p->y), std::fabs(p->z)});
+    }
+    for (const auto& f : {std::array<const Vec3*, 3>{&b, &c, &d}, std::array<const Vec3*, 3>{&a, &c, &d},
+                          std::array<const Vec3*, 3>{&a, &b, &d}, std::array<const Vec3*, 3>{&a, &b, &c}}) {
+      max_face = std::max(max_face, geom::Norm(geom::Cross(*f[1] - *f[0], *f[2] - *f[0])) / 2);
+    }
+    const double h = max_face > 0 ? 3 * std::fabs(q.volume) / max_face : 0;
+    const double slack = h > 0 ? 8 * std::ldexp(scale, -52) / h * (180 / M_PI) : 180;
+    worst = std::max(worst, q.max_dihedral_deg - slack);
+  }
+  return worst;
+}
+
 QualityReport ComputeQuality(const TetMesh& mesh, const std::vector<uint8_t>& crease_vertex) {
   struct Acc {
     std::vector<double> re, dih, min_dih, aspect;

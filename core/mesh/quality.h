@@ -55,6 +55,16 @@ struct QualityReport {
 QualityReport ComputeQuality(const TetMesh& mesh,
                              const std::vector<uint8_t>& crease_vertex = {});
 
+// The largest dihedral angle (degrees) of the tets with a flagged vertex, each
+// less the most that rounding its vertices to doubles can have moved it:
+// 8·u/h radians, u = 2^-52 · the tet's largest |coordinate|, h = its smallest
+// altitude (a vertex moved by δ turns the normals of its faces by at most
+// δ/h). A mesher computes in its own coordinates and rounds Steiner points
+// into the input's; far from the origin that moves the angles of small tets
+// (random_plcs.py near+rot+far 5: 3.9e-5 degrees over the stitched stars' own
+// largest angle). 0 when no tet has a flagged vertex.
+double MaxDihedralLessRounding(const TetMesh& mesh, const std::vector<uint8_t>& flagged_vertex);
+
 // Several lines of text for the CLI ("svrc mesh --stats"); ends with '\n'.
 std::string FormatQualityReport(const QualityReport& report);
 

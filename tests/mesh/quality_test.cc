@@ -109,6 +109,38 @@ TEST(Distribution, SelectionEqualsTheSortedDefinition) {
   }
 }
 
+// A tet's largest dihedral less its rounding allowance never exceeds the angle
+// of the unrounded tet: small random tets (edges ~1e-7, some flat) measured
+// near the origin and again moved to coordinates ~1e4, where rounding moves
+// their angles (near+rot+far 5 of the random sweep: 3.9e-5 degrees).
+TEST(QualityReport, MaxDihedralLessRoundingCoversTheRoundingOfFarCoordinates) {
+  std::mt19937_64 rng(39);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Vec3 far(12345.678, -9876.54, 4321.0);
+  int rounded_over = 0;
+  for (int i = 0; i < 2000; ++i) {
+    TetMesh near, moved;
+    for (int k = 0; k < 4; ++k) {
+      Vec3 p(u(rng), u(rng), (i % 2 == 0 ? 0.05 : 1) * u(rng));
+      near.positions.push_back(1e-7 * p);
+      moved.positions.push_back(far + 1e-7 * p);
+    }
+    near.tets = moved.tets = {{0, 1, 2, 3}};
+    const std::vector<uint8_t> all(4, 1);
+    const double exact = ComputeTetQuality(near.positions[0], near.positions[1], near.positions[2],
+                                           near.positions[3]).max_dihedral_deg;
+    const double measured = ComputeTetQuality(moved.positions[0], moved.positions[1], moved.positions[2],
+                                              moved.positions[3]).max_dihedral_deg;
+    rounded_over += measured > exact + 1e-6 ? 1 : 0;
+    EXPECT_LE(MaxDihedralLessRounding(moved, all), exact + 1e-9) << i;
+    // Near the origin the allowance is negligible.
+    EXPECT_NEAR(MaxDihedralLessRounding(near, all), exact, 1e-6) << i;
+  }
+  EXPECT_GT(rounded_over, 100);  // the rounding does move angles there
+  TetMesh none;
+  EXPECT_EQ(MaxDihedralLessRounding(none, {}), 0);
+}
+
 TEST(QualityReport, SplitsByCreaseVertex) {
   TetMesh m;
   for (const Vec3& p : kReg) m.positions.push_back(p);

@@ -55,7 +55,8 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what, const co
   if (!m.ok()) return out;
   out.tets = m->tets.size();
   out.conformity = mesh::CheckConformity(plc, *m);
-  out.quality = mesh::ComputeQuality(*m, mesh::CreaseVertexFlags(plc, *m));
+  const std::vector<uint8_t> crease_flags = mesh::CreaseVertexFlags(plc, *m);
+  out.quality = mesh::ComputeQuality(*m, crease_flags);
   EXPECT_TRUE(out.conformity.ok()) << what << ": " << out.conformity.Summary();
   EXPECT_GT(out.quality.crease.num_tets, 0u) << what << ": no tet touches a crease (collars not used?)";
   // The radius-edge bound holds away from the creases (thesis Theorem 4).
@@ -71,8 +72,9 @@ CreaseMeshed MeshAndCheck(const plc::Plc& plc, const std::string& what, const co
     EXPECT_GT(st.Get("svrc.stitch_stars"), 0) << what;
     EXPECT_EQ(st.Get("svrc.stitch_violations", -1), 0) << what;
     // The sliver flips keep the stitch's largest dihedral next to the creases
-    // (they made crease_pair 10°'s 156.4° into 165.4° before session 11).
-    EXPECT_LE(out.quality.crease.dihedral_deg.max, stitched_max + 1e-6) << what;
+    // (they made crease_pair 10°'s 156.4° into 165.4° before session 11),
+    // up to the rounding of the output's coordinates (MaxDihedralLessRounding).
+    EXPECT_LE(mesh::MaxDihedralLessRounding(*m, crease_flags), stitched_max + 1e-6) << what;
     // The true representation angles are tested unless the rounds fell back
     // to the snap band (svrc.collar_snap > 0): every star and book within σ
     // (MeshParams' default 60°), the σ of the bounds.
@@ -1545,6 +1547,52 @@ TEST(CreaseMesh, FacetsPlanarOnlyToRoundingFarFromTheOriginMesh) {
   const CreaseMeshed out = MeshPolyTextAndCheck(kPrismRotFar10, "prism_rot_far_10.poly", "prism+rot+far 10");
   EXPECT_GT(out.tets, 10000u);
   EXPECT_GT(out.stats.Get("svrc.collars"), 0);
+}
+
+// random_plcs.py near+rot+far 2: features ~1e-4 apart, rotated, at coordinates
+// ~1e4. The mesh is right, but a tet next to a crease came out 6.9e-6 degrees
+// above the stitched stars' largest dihedral: the stitch measures in the
+// refiner's coordinates, and the output's Steiner points are those rounded
+// into the input's, 1.8e-12 apart here. MeshAndCheck now allows that rounding
+// (mesh::MaxDihedralLessRounding); session 39.
+constexpr const char* kNearRotFar2 = R"(11 3 0 0
+1 12345.669489978625 -9876.538641549161 4320.999143175906
+2 12345.676522664415 -9876.53153597786 4320.998914731018
+3 12345.68093855354 -9876.535650229798 4321.006887989713
+4 12345.673905867752 -9876.542755801102 4321.007116434601
+5 12345.67506144646 -9876.544349770204 4320.993112010287
+6 12345.682094132248 -9876.5372441989 4320.992883565399
+7 12345.686510021374 -9876.54135845084 4321.000856824094
+8 12345.679477335585 -9876.548464022142 4321.001085268982
+9 12345.674069545015 -9876.537880736912 4321.00263037173
+10 12345.674979735702 -9876.53754778983 4321.003146433477
+11 12345.675402590985 -9876.537642900823 4321.003624638538
+7 1
+1 0 1
+4 1 4 3 2
+1 0 1
+4 5 6 7 8
+1 0 1
+4 1 2 6 5
+1 0 1
+4 2 3 7 6
+1 0 1
+4 3 4 8 7
+1 0 1
+4 4 1 5 8
+1 0 3
+3 9 10 11
+0
+0
+)";
+
+TEST(CreaseMesh, OutputRoundingFarFromTheOriginKeepsTheStitchedBound) {
+  const CreaseMeshed out = MeshPolyTextAndCheck(kNearRotFar2, "near_rot_far_2.poly", "near+rot+far 2");
+  EXPECT_GT(out.stats.Get("svrc.collars"), 0);
+  // The plain largest angle is over it: the allowance is what the test needs.
+  const double stitched =
+      std::max(out.stats.Get("svrc.max_bounded_dihedral_deg"), out.stats.Get("svrc.max_unbounded_dihedral_deg"));
+  EXPECT_GT(out.quality.crease.dihedral_deg.max, stitched + 1e-6);
 }
 
 }  // namespace
