@@ -125,7 +125,8 @@ int main(int argc, char** argv) {
       "stitched %.2f%s collars %g snap %g star_sigma %.1f%s mild_overrun %g regions %zu%s%s\n",
       ok ? "OK" : "BAD", m->tets.size(), rep.ok() ? "yes" : rep.Summary().substr(0, 200).c_str(), vmax,
       vol_ok ? "" : " VOLUME_OVER", q.other.radius_edge.max, re_ok ? "" : " RADIUS_EDGE_OVER", q.other.dihedral_deg.min,
-      q.other.dihedral_deg.max, q.crease.num_tets, q.crease.dihedral_deg.max, stitched, dih_ok ? "" : absl::StrFormat(" DIHEDRAL_OVER(+%.3g)", crease_dih_rounded - stitched).c_str(),
+      q.other.dihedral_deg.max, q.crease.num_tets, q.crease.dihedral_deg.max, stitched,
+      dih_ok ? "" : absl::StrFormat(" DIHEDRAL_OVER(+%.3g)", crease_dih_rounded - stitched).c_str(),
       st.Get("svrc.collars"), st.Get("svrc.collar_snap"), st.Get("svrc.star_sigma_max_deg"), sigma_ok ? "" : " SIGMA_OVER",
       st.Get("mild_crease_budget_overrun"), m->regions.size(), region_ok ? "" : " REGION_VOLUME_OVER",
       seeds_ok ? "" : " SEED_REGION_WRONG");

@@ -718,10 +718,6 @@ class Checker {
     }
   }
 
-  // Enclosed volume by the divergence theorem, when the valid facets form
-  // closed, consistently orientable 2-manifold surfaces (no internal facets);
-  // nested surfaces and volume holes are resolved by winding numbers
-  // (docs/conformity.md).
   // The volume by which a mesh whose facet triangles are within each facet's
   // tolerance of it may differ from the volumes the facets enclose: the sum
   // of area x tolerance. Negligible for planar facets (8 ulps); a facet
@@ -735,6 +731,10 @@ class Checker {
     return v;
   }
 
+  // Enclosed volume by the divergence theorem, when the valid facets form
+  // closed, consistently orientable 2-manifold surfaces (no internal facets);
+  // nested surfaces and volume holes are resolved by winding numbers
+  // (docs/conformity.md).
   void CheckVolume() {
     if (opt_.keep_bounding_box) {
       if (!mesh_box_.Empty()) {
@@ -1456,10 +1456,11 @@ class Checker {
       return false;
     }
     const double scale = std::max(rep_->enclosed_volume, 1e-300);
+    const double flatness_volume = FlatnessVolume();
     for (int32_t c = 0; c <= num_bounded_cells_; ++c) {
       const bool meshed = !cell_hole_[c];
       const double want = meshed ? cell_volume_[c] : 0;
-      if (std::fabs(cell_mesh[c] - want) <= std::max(opt_.volume_rel_tol * std::max(want, scale), FlatnessVolume())) {
+      if (std::fabs(cell_mesh[c] - want) <= std::max(opt_.volume_rel_tol * std::max(want, scale), flatness_volume)) {
         continue;
       }
       std::string seeds;
