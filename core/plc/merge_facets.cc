@@ -1,9 +1,12 @@
 // Surface soups to PLCs: exact vertex merging (STL) and merging of exactly
-// coplanar edge-adjacent faces with equal markers into polygonal facets
+// (or, within a tolerance, nearly) coplanar edge-adjacent faces with equal
+// markers into polygonal facets
 // (guide §5 item 7: the STL cube must become six quadrilaterals, not twelve
 // triangles whose 45° corners would all be creases).
 #include <algorithm>
 #include <bit>
+#include <cmath>
+#include <initializer_list>
 #include <cstring>
 #include <map>
 #include <numeric>
@@ -60,9 +63,61 @@ bool OnPlane(const std::vector<Vec3>& v, const std::array<uint32_t, 3>& t, const
   return true;
 }
 
+// Every vertex of f within tol of the plane of triple t.
+bool NearPlane(const std::vector<Vec3>& v, const std::array<uint32_t, 3>& t, const std::vector<uint32_t>& f,
+               double tol) {
+  const Vec3 n = geom::Cross(v[t[1]] - v[t[0]], v[t[2]] - v[t[0]]);
+  const double len = geom::Norm(n);
+  if (!(len > 0)) return false;
+  for (uint32_t x : f) {
+    if (!(std::fabs(geom::Dot(n, v[x] - v[t[0]])) <= tol * len)) return false;
+  }
+  return true;
+}
+
+double Diameter(const std::vector<Vec3>& v, std::initializer_list<const std::vector<uint32_t>*> faces) {
+  geom::Box3 box;
+  for (const std::vector<uint32_t>* f : faces) {
+    for (uint32_t x : *f) box.Add(v[x]);
+  }
+  return geom::Norm(box.hi - box.lo);
+}
+
+// The group's faces lie within rel x its diameter of one plane: the sum of
+// their area vectors through the centroid of their vertices.
+bool GroupFlat(const std::vector<Vec3>& v, const std::vector<std::vector<uint32_t>>& faces,
+               const std::vector<uint32_t>& group, double rel) {
+  // Relative to one vertex: far from the origin the products of absolute
+  // coordinates would cancel.
+  const Vec3 o = v[faces[group[0]][0]];
+  Vec3 n(0, 0, 0), c(0, 0, 0);
+  geom::Box3 box;
+  size_t count = 0;
+  for (uint32_t f : group) {
+    const std::vector<uint32_t>& face = faces[f];
+    for (size_t i = 0; i < face.size(); ++i) {
+      n = n + geom::Cross(v[face[i]] - o, v[face[(i + 1) % face.size()]] - o);
+      c = c + v[face[i]];
+      box.Add(v[face[i]]);
+      ++count;
+    }
+  }
+  const double len = geom::Norm(n);
+  if (!(len > 0) || count == 0) return false;
+  n = n / len;
+  c = c / static_cast<double>(count);
+  const double tol = rel * geom::Norm(box.hi - box.lo);
+  for (uint32_t f : group) {
+    for (uint32_t x : faces[f]) {
+      if (!(std::fabs(geom::Dot(n, v[x] - c)) <= tol)) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
-Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar) {
+Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, double coplanar_tolerance) {
   Plc plc;
   plc.is_surface = true;
   plc.index_base = soup.index_base;
@@ -152,7 +207,9 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar) 
   std::sort(edges.begin(), edges.end(), [](const E& x, const E& y) {
     return std::tie(x.lo, x.hi, x.face) < std::tie(y.lo, y.hi, y.face);
   });
-  UnionFind uf(nf);
+  // uf: exactly coplanar pairs; near: those and the nearly coplanar ones.
+  UnionFind uf(nf), near(nf);
+  bool any_near = false;
   for (size_t k = 0; k < edges.size();) {
     size_t e = k;
     while (e < edges.size() && edges[e].lo == edges[k].lo && edges[e].hi == edges[k].hi) ++e;
@@ -160,16 +217,39 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar) 
       const E& x = edges[k];
       const E& y = edges[k + 1];
       if (x.face != y.face && x.forward != y.forward && mergeable[x.face] && mergeable[y.face] &&
-          soup.face_markers[x.face] == soup.face_markers[y.face] &&
-          OnPlane(V, plane[x.face], soup.faces[y.face])) {
-        uf.Union(x.face, y.face);
+          soup.face_markers[x.face] == soup.face_markers[y.face]) {
+        const std::vector<uint32_t>& fx = soup.faces[x.face];
+        const std::vector<uint32_t>& fy = soup.faces[y.face];
+        if (OnPlane(V, plane[x.face], fy)) {
+          uf.Union(x.face, y.face);
+          near.Union(x.face, y.face);
+        } else if (coplanar_tolerance > 0) {
+          const double tol = coplanar_tolerance * Diameter(V, {&fx, &fy});
+          if (NearPlane(V, plane[x.face], fy, tol) && NearPlane(V, plane[y.face], fx, tol)) {
+            near.Union(x.face, y.face);
+            any_near = true;
+          }
+        }
       }
     }
     k = e;
   }
-  // Groups in order of their first face.
+  // Groups in order of their first face: the nearly coplanar groups that are
+  // flat as a whole, else their exactly coplanar subgroups.
   std::map<uint32_t, std::vector<uint32_t>> groups;
-  for (uint32_t f = 0; f < nf; ++f) groups[uf.Find(f)].push_back(f);
+  if (any_near) {
+    std::map<uint32_t, std::vector<uint32_t>> near_groups;
+    for (uint32_t f = 0; f < nf; ++f) near_groups[near.Find(f)].push_back(f);
+    for (auto& [root, faces] : near_groups) {
+      if (faces.size() > 1 && GroupFlat(V, soup.faces, faces, coplanar_tolerance)) {
+        groups[root] = std::move(faces);
+      } else {
+        for (uint32_t f : faces) groups[nf + uf.Find(f)].push_back(f);
+      }
+    }
+  } else {
+    for (uint32_t f = 0; f < nf; ++f) groups[uf.Find(f)].push_back(f);
+  }
   std::vector<std::vector<uint32_t>> ordered;
   for (auto& [root, faces] : groups) ordered.push_back(std::move(faces));
   std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a[0] < b[0]; });

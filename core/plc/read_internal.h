@@ -40,8 +40,9 @@ absl::Status ReadObj(std::string_view bytes, const std::string& name, SurfaceSou
 absl::Status ReadMedit(std::string_view bytes, const std::string& name, SurfaceSoup* soup);
 
 // Merges exactly equal vertices when `merge_vertices` (STL), then, when
-// `merge_coplanar`, exactly coplanar edge-adjacent faces with equal markers
-// into polygonal facets (merge_facets.cc).
-Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar);
+// `merge_coplanar`, coplanar edge-adjacent faces with equal markers into
+// polygonal facets: exactly coplanar ones, and nearly coplanar ones within
+// `coplanar_tolerance` (ReadOptions::coplanar_tolerance; merge_facets.cc).
+Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, double coplanar_tolerance = 0);
 
 }  // namespace svrc::plc::internal

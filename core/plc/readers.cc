@@ -77,7 +77,7 @@ absl::StatusOr<Plc> Read(std::string_view bytes, InputFormat format, std::string
       if (format == InputFormat::kMedit) s = internal::ReadMedit(bytes, sname, &soup);
       if (!s.ok()) return s;
       plc = internal::BuildSurfacePlc(std::move(soup), format == InputFormat::kStl,
-                                      options.merge_coplanar);
+                                      options.merge_coplanar, options.coplanar_tolerance);
       plc.source_name = sname;
       break;
     }

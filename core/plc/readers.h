@@ -19,8 +19,8 @@ absl::StatusOr<InputFormat> FormatFromPath(std::string_view path);
 std::string_view FormatName(InputFormat format);
 
 // Parses `bytes` in `format`; `name` is used in messages and Plc::source_name.
-// Sets Plc::input_sha256. Surface formats merge exactly coplanar adjacent
-// triangles with equal markers into polygonal facets.
+// Sets Plc::input_sha256. Surface formats merge coplanar adjacent triangles
+// with equal markers into polygonal facets (ReadOptions).
 absl::StatusOr<Plc> ReadPlcBytes(std::string_view bytes, InputFormat format,
                                  std::string_view name);
 
@@ -31,6 +31,18 @@ struct ReadOptions {
   // Surface formats: merge exactly coplanar edge-adjacent faces with equal
   // markers into polygonal facets (the default; false keeps one facet per face).
   bool merge_coplanar = true;
+  // With merge_coplanar: faces also merge when nearly coplanar, i.e. the other
+  // face's vertices are within this fraction of the pair's diameter of one
+  // face's plane, provided the whole merged group then lies within this
+  // fraction of its diameter of its own plane (else the group merges only
+  // its exactly coplanar faces). Half the validation's planarity tolerance
+  // (ValidationOptions::planarity_tolerance, TetGen's -T 1e-8), so a merged
+  // facet is valid. 0: exactly coplanar only. A surface rotated or moved in
+  // floating point is coplanar only up to rounding (session 39: hinge.stl
+  // turned by a random rotation kept 1,159 facets instead of 562, every
+  // split quad's 45-degree corners became crease points, and the run hit the
+  // vertex budget).
+  double coplanar_tolerance = 5e-9;
 };
 absl::StatusOr<Plc> ReadPlcBytes(std::string_view bytes, InputFormat format,
                                  std::string_view name, const ReadOptions& options);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <set>
 #include <string>
@@ -95,6 +96,78 @@ TEST(Readers, FiveCubeFilesGiveOnePlc) {
   ReadOptions no_merge;
   no_merge.merge_coplanar = false;
   EXPECT_EQ(MustRead("a_convex/cube_binary.stl", no_merge).facets.size(), 12u);
+}
+
+// An OFF text of `pts` and triangles `tris`.
+std::string OffText(const std::vector<std::array<double, 3>>& pts, const std::vector<std::array<int, 3>>& tris) {
+  std::string s = "OFF\n" + std::to_string(pts.size()) + " " + std::to_string(tris.size()) + " 0\n";
+  char buf[128];
+  for (const auto& p : pts) {
+    std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g\n", p[0], p[1], p[2]);
+    s += buf;
+  }
+  for (const auto& t : tris) s += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
+  return s;
+}
+
+// A surface turned or moved in floating point is coplanar only up to rounding:
+// hinge.stl turned by a random rotation kept 1,159 facets instead of 562, and
+// every split quad's 45-degree corners became crease points (session 39).
+// Nearly coplanar neighbours now merge (ReadOptions::coplanar_tolerance).
+TEST(Readers, NearlyCoplanarTrianglesMerge) {
+  // The cube's 12 triangles turned about (1, 2, 3) by 0.3 rad and moved to ~1e4:
+  // none of its faces is exactly planar any more.
+  const double ax[3] = {1 / std::sqrt(14.0), 2 / std::sqrt(14.0), 3 / std::sqrt(14.0)};
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  std::vector<std::array<double, 3>> pts;
+  for (int i = 0; i < 8; ++i) {
+    const double p[3] = {double(i & 1) - 0.5, double((i >> 1) & 1) - 0.5, double((i >> 2) & 1) - 0.5};
+    const double d = ax[0] * p[0] + ax[1] * p[1] + ax[2] * p[2];
+    const double x[3] = {ax[1] * p[2] - ax[2] * p[1], ax[2] * p[0] - ax[0] * p[2], ax[0] * p[1] - ax[1] * p[0]};
+    std::array<double, 3> q;
+    for (int k = 0; k < 3; ++k) q[k] = p[k] * c + x[k] * s + ax[k] * d * (1 - c);
+    pts.push_back({12345.678 + q[0], -9876.54 + q[1], 4321.0 + q[2]});
+  }
+  // Outward, two triangles per face (corner i = x + 2y + 4z).
+  const std::vector<std::array<int, 3>> tris = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                                                {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  const std::string text = OffText(pts, tris);
+  ReadOptions exact;
+  exact.coplanar_tolerance = 0;
+  absl::StatusOr<Plc> e = ReadPlcBytes(text, InputFormat::kOff, "turned_cube.off", exact);
+  ASSERT_TRUE(e.ok()) << e.status();
+  EXPECT_EQ(e->facets.size(), 12u);
+  absl::StatusOr<Plc> n = ReadPlcBytes(text, InputFormat::kOff, "turned_cube.off");
+  ASSERT_TRUE(n.ok()) << n.status();
+  ASSERT_EQ(n->facets.size(), 6u);
+  for (const Facet& f : n->facets) {
+    ASSERT_EQ(f.polygons.size(), 1u);
+    EXPECT_EQ(f.polygons[0].vertices.size(), 4u);
+  }
+}
+
+// Nearly coplanar pairs merge only into a group that is flat as a whole: a
+// strip of 40 exactly planar quads (two triangles each), consecutive quads
+// turned by 4e-9 rad, is curved by ~1e-8 of its length, so it stays 40 facets;
+// unbent it is one.
+TEST(Readers, NearlyCoplanarGroupMustBeFlatAsAWhole) {
+  for (const double bend : {0.0, 2e-9}) {
+    std::vector<std::array<double, 3>> pts;
+    std::vector<std::array<int, 3>> tris;
+    const int n = 40;
+    for (int i = 0; i <= n; ++i) {
+      const double z = bend * i * i;  // z depends on x only: every quad exactly planar
+      pts.push_back({double(i), 0, z});
+      pts.push_back({double(i), 1, z});
+    }
+    for (int i = 0; i < n; ++i) {
+      tris.push_back({2 * i, 2 * i + 2, 2 * i + 3});
+      tris.push_back({2 * i, 2 * i + 3, 2 * i + 1});
+    }
+    absl::StatusOr<Plc> p = ReadPlcBytes(OffText(pts, tris), InputFormat::kOff, "strip.off");
+    ASSERT_TRUE(p.ok()) << p.status();
+    EXPECT_EQ(p->facets.size(), bend == 0 ? 1u : size_t(n)) << bend;
+  }
 }
 
 TEST(Readers, KnifeEdgeObjEqualsPoly) {
