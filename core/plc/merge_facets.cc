@@ -254,11 +254,9 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, 
   for (auto& [root, faces] : groups) ordered.push_back(std::move(faces));
   std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a[0] < b[0]; });
 
-  for (const auto& group : ordered) {
-    if (group.size() == 1) {
-      emit_face(group[0]);
-      continue;
-    }
+  // Emits the group as one facet if its boundary is a simple polygon with
+  // holes; false (nothing emitted) otherwise.
+  auto emit_group = [&](const std::vector<uint32_t>& group) -> bool {
     // Boundary = directed edges whose reverse is not in the group.
     std::map<std::pair<uint32_t, uint32_t>, int> count;
     for (uint32_t f : group) {
@@ -336,17 +334,36 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, 
       }
       ok = ok && outer_count == 1;
     }
-    if (!ok) {
-      // Not a simple polygon with holes (pinch vertex, inconsistent
-      // orientation): keep the faces as they are.
-      for (uint32_t f : group) emit_face(f);
-      continue;
-    }
+    if (!ok) return false;
     facet.marker = soup.face_markers[group[0]];
     facet.input_faces = group;
     plc.facets.push_back(std::move(facet));
     plc.facet_lines.push_back(soup.face_lines[group[0]]);
     (void)nboundary;
+    return true;
+  };
+  for (const auto& group : ordered) {
+    if (group.size() == 1) {
+      emit_face(group[0]);
+      continue;
+    }
+    if (emit_group(group)) continue;
+    // Not a simple polygon with holes (pinch vertex, inconsistent
+    // orientation). A group joined by nearly coplanar pairs falls back to its
+    // exactly coplanar subgroups; the faces of any other stay as they are.
+    std::map<uint32_t, std::vector<uint32_t>> exact;
+    for (uint32_t f : group) exact[uf.Find(f)].push_back(f);
+    if (exact.size() == 1) {
+      for (uint32_t f : group) emit_face(f);
+      continue;
+    }
+    std::vector<std::vector<uint32_t>> subgroups;
+    for (auto& [root, faces] : exact) subgroups.push_back(std::move(faces));
+    std::sort(subgroups.begin(), subgroups.end(), [](const auto& a, const auto& b) { return a[0] < b[0]; });
+    for (const auto& sub : subgroups) {
+      if (sub.size() > 1 && emit_group(sub)) continue;
+      for (uint32_t f : sub) emit_face(f);
+    }
   }
   return plc;
 }

@@ -170,6 +170,31 @@ TEST(Readers, NearlyCoplanarGroupMustBeFlatAsAWhole) {
   }
 }
 
+// A group joined by nearly coplanar pairs whose boundary is not simple falls
+// back to its exactly coplanar subgroups, not to single faces: a ring of seven
+// unit cells (two triangles each) that touches itself at a vertex (a pinch),
+// on z = c·x², so each column of cells is exactly planar and the columns are
+// nearly coplanar. Exactly flat (c = 0) it is one exact group with a pinch:
+// 14 triangles, as before.
+TEST(Readers, NearlyCoplanarGroupThatPinchesFallsBackToExactGroups) {
+  for (const double c : {0.0, 1e-10}) {
+    std::vector<std::array<double, 3>> pts;
+    auto id = [](int x, int y) { return 4 * (y + 1) + x; };  // x in 0..3, y in -1..2
+    for (int y = -1; y <= 2; ++y) {
+      for (int x = 0; x <= 3; ++x) pts.push_back({double(x), double(y), c * x * x});
+    }
+    std::vector<std::array<int, 3>> tris;
+    for (const auto& [i, j] : std::vector<std::pair<int, int>>{{0, 0}, {0, -1}, {1, -1}, {2, -1}, {2, 0}, {2, 1}, {1, 1}}) {
+      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+    absl::StatusOr<Plc> p = ReadPlcBytes(OffText(pts, tris), InputFormat::kOff, "ring.off");
+    ASSERT_TRUE(p.ok()) << p.status();
+    // c > 0: columns x = 0 (2 cells), x = 1 (two separate cells), x = 2 (3 cells).
+    EXPECT_EQ(p->facets.size(), c == 0 ? 14u : 4u) << c;
+  }
+}
+
 TEST(Readers, KnifeEdgeObjEqualsPoly) {
   const Plc poly = MustRead("c_creases/knife_edge.poly");
   const Plc obj = MustRead("c_creases/knife_edge.obj");
