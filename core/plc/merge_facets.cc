@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <initializer_list>
 #include <cstring>
+#include <initializer_list>
 #include <map>
 #include <numeric>
 #include <utility>
@@ -111,6 +111,50 @@ bool GroupFlat(const std::vector<Vec3>& v, const std::vector<std::vector<uint32_
     for (uint32_t x : faces[f]) {
       if (!(std::fabs(geom::Dot(n, v[x] - c)) <= tol)) return false;
     }
+  }
+  return true;
+}
+
+// A facet merged from nearly coplanar faces is kept only if (1) every vertex of
+// its faces is on its boundary loops: an interior vertex (a fan's centre) would
+// be left as a point near the facet but not on it, a feature 1e-9 of the size
+// away from it; and (2) it passes validation's planarity test with a factor 2
+// to spare (prepare.cc: the Newell normal of its largest loop through the
+// centroid of its points, every point within planarity_tolerance = 1e-8 of
+// the diameter; here within `rel`).
+bool NearGroupFacetOk(const std::vector<Vec3>& v, const std::vector<uint32_t>& group,
+                      const std::vector<std::vector<uint32_t>>& faces, const Facet& facet, double rel) {
+  std::vector<uint32_t> on_loops, in_faces;
+  for (const Polygon& poly : facet.polygons) on_loops.insert(on_loops.end(), poly.vertices.begin(), poly.vertices.end());
+  for (uint32_t f : group) in_faces.insert(in_faces.end(), faces[f].begin(), faces[f].end());
+  std::sort(on_loops.begin(), on_loops.end());
+  on_loops.erase(std::unique(on_loops.begin(), on_loops.end()), on_loops.end());
+  std::sort(in_faces.begin(), in_faces.end());
+  in_faces.erase(std::unique(in_faces.begin(), in_faces.end()), in_faces.end());
+  if (in_faces != on_loops) return false;
+  Vec3 normal(0, 0, 0);
+  double best = -1;
+  for (const Polygon& poly : facet.polygons) {
+    const Vec3& o = v[poly.vertices[0]];
+    Vec3 n(0, 0, 0);
+    for (size_t i = 0; i < poly.vertices.size(); ++i) {
+      n = n + geom::Cross(v[poly.vertices[i]] - o, v[poly.vertices[(i + 1) % poly.vertices.size()]] - o);
+    }
+    if (geom::Norm(n) > best) best = geom::Norm(n), normal = n;
+  }
+  if (!(best > 0)) return false;
+  normal = normal / best;
+  const Vec3& o = v[on_loops[0]];
+  Vec3 centroid(0, 0, 0);
+  geom::Box3 box;
+  for (uint32_t x : on_loops) {
+    centroid = centroid + (v[x] - o);
+    box.Add(v[x]);
+  }
+  centroid = o + centroid / static_cast<double>(on_loops.size());
+  const double tol = rel * geom::Norm(box.hi - box.lo);
+  for (uint32_t x : on_loops) {
+    if (!(std::fabs(geom::Dot(v[x] - centroid, normal)) <= tol)) return false;
   }
   return true;
 }
@@ -257,6 +301,9 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, 
   // Emits the group as one facet if its boundary is a simple polygon with
   // holes; false (nothing emitted) otherwise.
   auto emit_group = [&](const std::vector<uint32_t>& group) -> bool {
+    // A group joined by nearly coplanar pairs (not all one exact group).
+    bool near_group = false;
+    for (uint32_t f : group) near_group = near_group || uf.Find(f) != uf.Find(group[0]);
     // Boundary = directed edges whose reverse is not in the group.
     std::map<std::pair<uint32_t, uint32_t>, int> count;
     for (uint32_t f : group) {
@@ -334,6 +381,7 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, 
       }
       ok = ok && outer_count == 1;
     }
+    if (ok && near_group) ok = NearGroupFacetOk(V, group, soup.faces, facet, coplanar_tolerance);
     if (!ok) return false;
     facet.marker = soup.face_markers[group[0]];
     facet.input_faces = group;

@@ -33,7 +33,7 @@ TEST(CorpusBig, FandiskMergesCoplanarTriangles) {
   EXPECT_EQ(plc->input_face_count, 12946u);
   // Nearly coplanar neighbours merged (ReadOptions::coplanar_tolerance, since
   // session 39); exactly coplanar ones only: 8035.
-  EXPECT_EQ(plc->facets.size(), 7797u);
+  EXPECT_EQ(plc->facets.size(), 7798u);
   ReadOptions exact;
   exact.coplanar_tolerance = 0;
   absl::StatusOr<Plc> e = ReadPlcFile(svrc::testing::CorpusPath("c_creases/fandisk.off"), exact);

@@ -195,6 +195,24 @@ TEST(Readers, NearlyCoplanarGroupThatPinchesFallsBackToExactGroups) {
   }
 }
 
+// A nearly coplanar group with a vertex inside it (a fan's centre) does not
+// merge: the merged facet would keep only its boundary, and the centre would
+// be a point 1e-12 off the facet, not on it. Exactly coplanar, the fan merges
+// into a hexagon and the centre is a point of the facet's interior, as before.
+TEST(Readers, NearlyCoplanarFanKeepsItsCentre) {
+  for (const double lift : {0.0, 1e-12}) {
+    std::vector<std::array<double, 3>> pts = {{0, 0, lift}};
+    std::vector<std::array<int, 3>> tris;
+    for (int k = 0; k < 6; ++k) {
+      pts.push_back({std::cos(k * M_PI / 3), std::sin(k * M_PI / 3), 0});
+      tris.push_back({0, 1 + k, 1 + (k + 1) % 6});
+    }
+    absl::StatusOr<Plc> p = ReadPlcBytes(OffText(pts, tris), InputFormat::kOff, "fan.off");
+    ASSERT_TRUE(p.ok()) << p.status();
+    EXPECT_EQ(p->facets.size(), lift == 0 ? 1u : 6u) << lift;
+  }
+}
+
 TEST(Readers, KnifeEdgeObjEqualsPoly) {
   const Plc poly = MustRead("c_creases/knife_edge.poly");
   const Plc obj = MustRead("c_creases/knife_edge.obj");

@@ -120,7 +120,7 @@ CreaseMeshed MeshCorpusFileAndCheck(const std::string& path) {
 // surface merge into facets (ReadOptions::coplanar_tolerance = 0). The
 // regression tests on hinge.stl and fandisk.off name facets and vertices of
 // that PLC; since session 39 the readers also merge nearly coplanar faces
-// (hinge.stl: 455 facets instead of 562; fandisk.off: 7,797 instead of 8,035).
+// (hinge.stl: 455 facets instead of 562; fandisk.off: 7,798 instead of 8,035).
 std::optional<plc::Plc> ReadExactlyCoplanar(const std::string& rel) {
   plc::ReadOptions exact;
   exact.coplanar_tolerance = 0;
