@@ -108,14 +108,12 @@ double MaxDihedralLessRounding(const TetMesh& mesh, const std::vector<uint8_t>& 
     const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]],
                &d = mesh.positions[t[3]];
     const TetQuality q = ComputeTetQuality(a, b, c, d);
-    double scale = 0, max_face = 0;
+    double scale = 0;
     for (const Vec3* p : {&a, &b, &c, &d}) {
       scale = std::max({scale, std::fabs(p->x), std::fabs(p->y), std::fabs(p->z)});
     }
-    for (const auto& f : {std::array<const Vec3*, 3>{&b, &c, &d}, std::array<const Vec3*, 3>{&a, &c, &d},
-                          std::array<const Vec3*, 3>{&a, &b, &d}, std::array<const Vec3*, 3>{&a, &b, &c}}) {
-      max_face = std::max(max_face, geom::Norm(geom::Cross(*f[1] - *f[0], *f[2] - *f[0])) / 2);
-    }
+    const double max_face =
+        std::max({TriangleArea(b, c, d), TriangleArea(a, c, d), TriangleArea(a, b, d), TriangleArea(a, b, c)});
     const double h = max_face > 0 ? 3 * std::fabs(q.volume) / max_face : 0;
     const double slack = h > 0 ? 8 * std::ldexp(scale, -52) / h * (180 / M_PI) : 180;
     worst = std::max(worst, q.max_dihedral_deg - slack);

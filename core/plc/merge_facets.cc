@@ -83,38 +83,6 @@ double Diameter(const std::vector<Vec3>& v, std::initializer_list<const std::vec
   return geom::Norm(box.hi - box.lo);
 }
 
-// The group's faces lie within rel x its diameter of one plane: the sum of
-// their area vectors through the centroid of their vertices.
-bool GroupFlat(const std::vector<Vec3>& v, const std::vector<std::vector<uint32_t>>& faces,
-               const std::vector<uint32_t>& group, double rel) {
-  // Relative to one vertex: far from the origin the products of absolute
-  // coordinates would cancel.
-  const Vec3 o = v[faces[group[0]][0]];
-  Vec3 n(0, 0, 0), c(0, 0, 0);
-  geom::Box3 box;
-  size_t count = 0;
-  for (uint32_t f : group) {
-    const std::vector<uint32_t>& face = faces[f];
-    for (size_t i = 0; i < face.size(); ++i) {
-      n = n + geom::Cross(v[face[i]] - o, v[face[(i + 1) % face.size()]] - o);
-      c = c + v[face[i]];
-      box.Add(v[face[i]]);
-      ++count;
-    }
-  }
-  const double len = geom::Norm(n);
-  if (!(len > 0) || count == 0) return false;
-  n = n / len;
-  c = c / static_cast<double>(count);
-  const double tol = rel * geom::Norm(box.hi - box.lo);
-  for (uint32_t f : group) {
-    for (uint32_t x : faces[f]) {
-      if (!(std::fabs(geom::Dot(n, v[x] - c)) <= tol)) return false;
-    }
-  }
-  return true;
-}
-
 // A facet merged from nearly coplanar faces is kept only if (1) every vertex of
 // its faces is on its boundary loops: an interior vertex (a fan's centre) would
 // be left as a point near the facet but not on it, a feature 1e-9 of the size
@@ -135,11 +103,7 @@ bool NearGroupFacetOk(const std::vector<Vec3>& v, const std::vector<uint32_t>& g
   Vec3 normal(0, 0, 0);
   double best = -1;
   for (const Polygon& poly : facet.polygons) {
-    const Vec3& o = v[poly.vertices[0]];
-    Vec3 n(0, 0, 0);
-    for (size_t i = 0; i < poly.vertices.size(); ++i) {
-      n = n + geom::Cross(v[poly.vertices[i]] - o, v[poly.vertices[(i + 1) % poly.vertices.size()]] - o);
-    }
+    const Vec3 n = NewellNormal(v, poly.vertices);
     if (geom::Norm(n) > best) best = geom::Norm(n), normal = n;
   }
   if (!(best > 0)) return false;
@@ -278,22 +242,11 @@ Plc BuildSurfacePlc(SurfaceSoup soup, bool merge_vertices, bool merge_coplanar, 
     }
     k = e;
   }
-  // Groups in order of their first face: the nearly coplanar groups that are
-  // flat as a whole, else their exactly coplanar subgroups.
+  // Groups in order of their first face (emit_group falls back from a
+  // nearly coplanar group to its exactly coplanar subgroups).
   std::map<uint32_t, std::vector<uint32_t>> groups;
-  if (any_near) {
-    std::map<uint32_t, std::vector<uint32_t>> near_groups;
-    for (uint32_t f = 0; f < nf; ++f) near_groups[near.Find(f)].push_back(f);
-    for (auto& [root, faces] : near_groups) {
-      if (faces.size() > 1 && GroupFlat(V, soup.faces, faces, coplanar_tolerance)) {
-        groups[root] = std::move(faces);
-      } else {
-        for (uint32_t f : faces) groups[nf + uf.Find(f)].push_back(f);
-      }
-    }
-  } else {
-    for (uint32_t f = 0; f < nf; ++f) groups[uf.Find(f)].push_back(f);
-  }
+  UnionFind& joined = any_near ? near : uf;
+  for (uint32_t f = 0; f < nf; ++f) groups[joined.Find(f)].push_back(f);
   std::vector<std::vector<uint32_t>> ordered;
   for (auto& [root, faces] : groups) ordered.push_back(std::move(faces));
   std::sort(ordered.begin(), ordered.end(), [](const auto& a, const auto& b) { return a[0] < b[0]; });

@@ -33,11 +33,10 @@ struct ReadOptions {
   bool merge_coplanar = true;
   // With merge_coplanar: faces also merge when nearly coplanar, i.e. the other
   // face's vertices are within this fraction of the pair's diameter of one
-  // face's plane, provided the whole merged group then lies within this
-  // fraction of its diameter of its own plane, every vertex of its faces is
-  // on its boundary, and it passes validation's planarity test within this
-  // fraction (else the group merges only its exactly coplanar faces; docs/
-  // plc.md "Nearly coplanar merging"). Half the validation's planarity tolerance
+  // face's plane, provided the whole merged group then passes validation's
+  // planarity test within this fraction and every vertex of its faces is on
+  // its boundary (else the group merges only its exactly coplanar faces;
+  // docs/plc.md "Nearly coplanar merging"). Half the validation's planarity tolerance
   // (ValidationOptions::planarity_tolerance, TetGen's -T 1e-8), so a merged
   // facet is valid. 0: exactly coplanar only. A surface rotated or moved in
   // floating point is coplanar only up to rounding (session 39: hinge.stl

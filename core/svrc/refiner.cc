@@ -461,6 +461,12 @@ class Refiner {
   // point as a facet Steiner point (CD (2,3)); returns how many went in. The
   // caller runs the queues, the COLLAR rounds and the stitch again.
   absl::StatusOr<uint32_t> RepairStitchedCrossings();
+  // Segment pa–pb crosses facet f's plane (SegmentCrossesPlane): its ends
+  // beyond tol on opposite sides, and beyond f's own flatness
+  // (facet_plane_tol_); *x = the crossing.
+  bool FacetCrossing(uint32_t f, const Vec3& pa, const Vec3& pb, double tol, Vec3* x) const {
+    return SegmentCrossesPlane(frames_[f].origin, frames_[f].normal, pa, pb, std::max(tol, facet_plane_tol_[f]), x);
+  }
  private:
   absl::StatusOr<bool> CollarRoundImpl();
   absl::Status StitchImpl();
@@ -639,11 +645,13 @@ class Refiner {
   // The conformity checker's on-plane tolerance (mesh::OnFeatureTolerance)
   // in normalised coordinates.
   double on_plane_tol_ = 0;
-  // Per facet: the largest distance of its input points from its frame's
-  // plane (normalised). Validation accepts facets planar to 1e-8 of their
-  // diameter (docs/plc.md); a slanted facet far from the origin is planar only
-  // to the rounding of its input coordinates, which the normalisation keeps.
-  std::vector<double> facet_flatness_;
+  // Per facet: twice the largest distance of its input points from its
+  // frame's plane (normalised), the least distance at which a point counts as
+  // off that plane (FacetCrossing, StitchedFacetFaces). Validation accepts
+  // facets planar to 1e-8 of their diameter (docs/plc.md); a slanted facet
+  // far from the origin is planar only to the rounding of its input
+  // coordinates, which the normalisation keeps.
+  std::vector<double> facet_plane_tol_;
   uint32_t facet_mesh0_ = 0;             // MeshId of facet 0 (= its FeatureId)
   std::vector<std::vector<uint32_t>> point_facets_;  // per complex point: facets containing it
   std::vector<std::vector<uint32_t>> seg_facets_;    // per segment: facets containing it
@@ -958,7 +966,7 @@ absl::Status Refiner::Setup(const plc::FeatureComplex& complex, std::span<const 
       if (p.value() < num_input_) point_facets_[p.value()].push_back(f);
       flat = std::max(flat, std::fabs(geom::Dot(points_.Xyz(p) - frame.origin, frame.normal)));
     }
-    facet_flatness_.push_back(flat);
+    facet_plane_tol_.push_back(2 * flat);
   }
 
   // Figure 3.3: UpdateLocation(∅, M_F, F) for every feature, lowest dimension
@@ -2498,11 +2506,6 @@ absl::Status Refiner::CreateCollar(PointId p, VertexId nv) {
   return absl::OkStatus();
 }
 
-// SegmentCrossesPlane (collar_geometry.h) for the plane of frame fr.
-bool CrossesPlane(const plc::FacetFrame& fr, const Vec3& pa, const Vec3& pb, double tol, Vec3* x) {
-  return SegmentCrossesPlane(fr.origin, fr.normal, pa, pb, tol, x);
-}
-
 // The point of the circle where `ball`'s sphere meets the plane of frame fr
 // (S ∩ F for a facet through the centre) radially nearest to uv, in fr's
 // coordinates; false when the plane misses the ball or uv is the circle's
@@ -2746,7 +2749,7 @@ absl::StatusOr<bool> Refiner::CollarRoundImpl() {
           const Vec3& pa = dt.Point(t.v[k]);
           const Vec3& pb = dt.Point(t.v[(k + 1) % 3]);
           Vec3 x;
-          if (!CrossesPlane(fr, pa, pb, std::max(1e-12 * ball.radius, 2 * facet_flatness_[f]), &x)) continue;
+          if (!FacetCrossing(f, pa, pb, 1e-12 * ball.radius, &x)) continue;
           Vec2 q;
           if (!NearestArcPoint(fr, ball, fr.ToPlane(x), &q)) continue;
           if (facets_[f].region().Locate(q) == FacetRegion::Where::kOutside) continue;
@@ -2959,7 +2962,7 @@ std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacet
     const Vec3& x = points_.Xyz(PointId(k[2]));
     for (uint32_t f : fa) {
       const plc::FacetFrame& fr = frames_[f];
-      if (!(std::fabs(geom::Dot(x - fr.origin, fr.normal)) <= std::max(on_plane_tol_, 2 * facet_flatness_[f]))) {
+      if (!(std::fabs(geom::Dot(x - fr.origin, fr.normal)) <= std::max(on_plane_tol_, facet_plane_tol_[f]))) {
         continue;
       }
       if (!CentroidInRegion(f, Uv(f, on[0]), Uv(f, on[1]), fr.ToPlane(x))) continue;
@@ -3015,9 +3018,7 @@ absl::StatusOr<uint32_t> Refiner::RepairStitchedCrossings() {
           const Vec3& pa = points_.Xyz(PointId(ia));
           const Vec3& pb = points_.Xyz(PointId(ib));
           Vec3 x;
-          if (!CrossesPlane(fr, pa, pb, std::max(1e-12 * collars_.ball(bi).radius, 2 * facet_flatness_[f]), &x)) {
-            continue;
-          }
+          if (!FacetCrossing(f, pa, pb, 1e-12 * collars_.ball(bi).radius, &x)) continue;
           Vec2 uv = fr.ToPlane(x);
           const uint32_t in = collars_.FindContaining(x);
           if (in != CollarIndex::kNone) {
