@@ -186,6 +186,16 @@ absl::Status WriteMeshOutput(const mesh::TetMesh& mesh, const std::string& path,
   return mesh::WriteMeshFile(mesh, path);
 }
 
+bool WarnMinDihedral(const mesh::MeshStats& stats) {
+  const double below = stats.Get("min_dihedral.below");
+  if (!(below > 0)) return false;
+  std::fprintf(stderr,
+               "svrc: warning: %.0f tets away from the creases are below min_dihedral %g degrees "
+               "(smallest %.4g); the sliver removal is best effort (docs/svrc-design.md section 8 item 69)\n",
+               below, stats.Get("min_dihedral.target"), stats.Get("min_dihedral.smallest"));
+  return true;
+}
+
 ProgressPrinter::ProgressPrinter(bool enabled) : enabled_(enabled), tty_(isatty(2) != 0) {}
 
 ProgressPrinter::~ProgressPrinter() { Done(); }

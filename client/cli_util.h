@@ -57,6 +57,10 @@ int UsageError(const Command& command, const std::string& message);
 // `quantization_bits`); .node/.vtu/.msh/.mesh → core/mesh/writers.h.
 absl::Status WriteMeshOutput(const mesh::TetMesh& mesh, const std::string& path,
                              int quantization_bits);
+// A run with min_dihedral that left tets (away from creases) below it says
+// so on stderr: "svrc: warning: ..." from the counters min_dihedral.* of
+// core::MeshPlc. Returns whether it printed.
+bool WarnMinDihedral(const mesh::MeshStats& stats);
 // Writes raw bytes (atomically: temp file + rename).
 absl::Status WriteFileBytes(const std::string& path, const std::string& bytes);
 

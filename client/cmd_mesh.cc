@@ -122,6 +122,7 @@ int RunMesh(const std::vector<std::string>& argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("wrote %s: %zu vertices, %zu tets, %zu boundary triangles in %.3f s\n", out.c_str(),
               mesh->num_vertices(), mesh->num_tets(), mesh->triangles.size(), seconds);
+  WarnMinDihedral(mesh->stats);
   if (args->switches.count("--stats")) {
     PrintCounters(mesh->stats);
     std::printf("  %-34s %d\n", "cli.huge_page_heap", util::HugePageHeapRequested() ? 1 : 0);

@@ -72,6 +72,9 @@ int FetchAndWrite(RemoteClient& client, const v1::Job& job, const std::string& o
   if (!s.ok()) return Fail(kExitJobFailed, absl::StrCat("cannot write ", out, ": ", s.message()));
   std::printf("wrote %s (%zu bytes fetched, sha256 %s)\n", out.c_str(), result->bytes.size(),
               result->sha256.c_str());
+  mesh::MeshStats stats;
+  for (const v1::Counter& c : job.result().stats()) stats.Set(c.name(), c.value());
+  WarnMinDihedral(stats);
   return kExitOk;
 }
 

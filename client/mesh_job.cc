@@ -29,7 +29,7 @@ absl::Status ValidateOptions(const MeshOptions& o) {
            CheckRange("theta", o.theta, 0, false, 1, false),
            CheckRange("max_rep_angle", o.max_rep_angle, 0, true, 180, true),
            CheckRange("max_volume", o.max_volume, -inf, true, inf, true),
-           CheckRange("min_dihedral", o.min_dihedral, -inf, true, 90, true),
+           CheckRange("min_dihedral", o.min_dihedral, -inf, true, core::kMaxMinDihedralDeg, true),
            CheckRange("collar_size_eps", o.collar_size_eps, 0, false, 1, false),
        }) {
     if (!s.ok()) return s;

@@ -14,6 +14,10 @@
 
 namespace svrc::core {
 
+// MeshParams::min_dihedral must be below this: a tet's smallest dihedral
+// angle is at most arccos(1/3) ≈ 70.53°, the regular tetrahedron's.
+inline constexpr double kMaxMinDihedralDeg = 70.5;
+
 // Mesh parameters. Names match the API (proto) and the CLI flags (`-` for `_`).
 struct MeshParams {
   // Radius-edge bound for tets not touching a crease [tau/2]. TetGen -q2.
@@ -44,7 +48,10 @@ struct MeshParams {
   bool collar_tet_quality = true;
   // Global max tet volume in input units³; <= 0: none.
   double max_volume = 0.0;
-  // Sliver removal target in degrees (thesis §6.2.1); <= 0: off.
+  // Sliver removal target in degrees (thesis §6.2.1; docs/svrc-design.md §8
+  // item 69), best effort: the sliver rounds and flips aim at it; the tets
+  // away from creases left below it are counted in the stats
+  // (min_dihedral.below, .smallest). <= 0: off; below kMaxMinDihedralDeg.
   double min_dihedral = 0.0;
   // Return the whole bounding-domain mesh instead of the PLC's regions.
   bool keep_bounding_box = false;

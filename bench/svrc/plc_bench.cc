@@ -15,6 +15,8 @@
 //   --radius-edge 2,1.414 bounds to run (svrc --radius-edge B, tetgen -pq<B>)
 //   --max-volume V        a global max volume (svrc --max-volume V, tetgen -a<V>)
 //                         for the FILE inputs after it (0: none again)
+//   --min-dihedral D      a smallest dihedral angle to aim at, every run
+//                         (svrc --min-dihedral D, tetgen -pq<B>/<D>)
 //   --tools svrc,tetgen   which peers run
 //   --timeout 120         seconds per run (then SIGKILL: "timeout")
 //   --mem-limit-mib 4096  RLIMIT_AS of each child (a run past it fails)
@@ -200,6 +202,7 @@ struct Options {
   std::string tetgen = "/usr/bin/tetgen";
   std::string workdir;
   bool keep = false;
+  double min_dihedral = 0;  // > 0: svrc --min-dihedral, tetgen -q<B>/<D>
 };
 
 // TetGen takes the volume as digits (no exponent): fixed notation, trimmed.
@@ -385,7 +388,7 @@ Measured RunTetgen(const Input& in, const fs::path& input_file, double bound,
   if (in.plc.IsPointSet()) {
     sw = "-Q";  // Delaunay of the points, as svrc does for a point set
   } else {
-    sw = absl::StrCat("-pq", absl::StrCat(bound), "A");
+    sw = absl::StrCat("-pq", absl::StrCat(bound), o.min_dihedral > 0 ? absl::StrCat("/", o.min_dihedral) : "", "A");
     bool region_volumes = false;
     for (const auto& r : in.plc.regions) region_volumes |= r.max_volume > 0;
     if (region_volumes) sw += "a";
@@ -441,6 +444,11 @@ Measured RunSvrc(const Input& in, const fs::path& input_file, double bound,
     argv.push_back("--max-volume");
     argv.push_back(absl::StrCat(in.max_volume));
     absl::StrAppend(&flags, " --max-volume ", in.max_volume);
+  }
+  if (o.min_dihedral > 0 && !in.plc.IsPointSet()) {
+    argv.push_back("--min-dihedral");
+    argv.push_back(absl::StrCat(o.min_dihedral));
+    absl::StrAppend(&flags, " --min-dihedral ", o.min_dihedral);
   }
   m.command = absl::StrCat("svrc mesh", flags.empty() ? "" : " ", flags);
   m.proc = RunProcess(argv, dir, dir / "svrc.out", dir / "svrc.err", o.timeout_s,
@@ -523,7 +531,7 @@ std::vector<double> ParseList(const std::string& s) {
 int Usage(const char* argv0) {
   std::fprintf(stderr,
                "usage: %s [--radius-edge 2,1.414] [--tools svrc,tetgen] [--timeout 120] "
-               "[--mem-limit-mib 4096] [--svrc PATH] [--tetgen PATH] [--workdir DIR] [--keep] "
+               "[--mem-limit-mib 4096] [--min-dihedral D] [--svrc PATH] [--tetgen PATH] [--workdir DIR] [--keep] "
                "[--list] INPUT...\n  INPUT: a PLC file, family:NAME (--family NAME), "
                "families (--families); --max-volume V applies to the files after it\n",
                argv0);
@@ -552,6 +560,8 @@ int Main(int argc, char** argv) {
       o.bounds = ParseList(value());
     } else if (a == "--max-volume") {
       specs.push_back("maxvol:" + value());
+    } else if (a == "--min-dihedral") {
+      o.min_dihedral = std::atof(value().c_str());
     } else if (a == "--tools") {
       const std::string t = value();
       o.run_svrc = t.find("svrc") != std::string::npos;

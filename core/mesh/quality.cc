@@ -98,27 +98,55 @@ Distribution Distribution::Of(std::vector<double> values) {
   return d;
 }
 
+namespace {
+
+// The most (degrees) that rounding the vertices of abcd to doubles can have
+// moved its dihedral angles: 8·u/h radians (MaxDihedralLessRounding).
+double RoundingSlackDeg(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const TetQuality& q) {
+  double scale = 0;
+  for (const Vec3* p : {&a, &b, &c, &d}) {
+    scale = std::max({scale, std::fabs(p->x), std::fabs(p->y), std::fabs(p->z)});
+  }
+  const double max_face =
+      std::max({TriangleArea(b, c, d), TriangleArea(a, c, d), TriangleArea(a, b, d), TriangleArea(a, b, c)});
+  const double h = max_face > 0 ? 3 * std::fabs(q.volume) / max_face : 0;
+  return h > 0 ? 8 * std::ldexp(scale, -52) / h * (180 / M_PI) : 180;
+}
+
+bool Touches(const std::array<uint32_t, 4>& t, const std::vector<uint8_t>& flagged_vertex) {
+  bool touches = false;
+  for (uint32_t v : t) touches = touches || flagged_vertex[v] != 0;
+  return touches;
+}
+
+}  // namespace
+
 double MaxDihedralLessRounding(const TetMesh& mesh, const std::vector<uint8_t>& flagged_vertex) {
   if (flagged_vertex.size() != mesh.positions.size()) return 0;
   double worst = 0;
   for (const auto& t : mesh.tets) {
-    bool touches = false;
-    for (uint32_t v : t) touches = touches || flagged_vertex[v] != 0;
-    if (!touches) continue;
+    if (!Touches(t, flagged_vertex)) continue;
     const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]],
                &d = mesh.positions[t[3]];
     const TetQuality q = ComputeTetQuality(a, b, c, d);
-    double scale = 0;
-    for (const Vec3* p : {&a, &b, &c, &d}) {
-      scale = std::max({scale, std::fabs(p->x), std::fabs(p->y), std::fabs(p->z)});
-    }
-    const double max_face =
-        std::max({TriangleArea(b, c, d), TriangleArea(a, c, d), TriangleArea(a, b, d), TriangleArea(a, b, c)});
-    const double h = max_face > 0 ? 3 * std::fabs(q.volume) / max_face : 0;
-    const double slack = h > 0 ? 8 * std::ldexp(scale, -52) / h * (180 / M_PI) : 180;
-    worst = std::max(worst, q.max_dihedral_deg - slack);
+    worst = std::max(worst, q.max_dihedral_deg - RoundingSlackDeg(a, b, c, d, q));
   }
   return worst;
+}
+
+MinDihedralShortfall BelowMinDihedral(const TetMesh& mesh, const std::vector<uint8_t>& crease_vertex,
+                                      double min_deg) {
+  const bool has_creases = crease_vertex.size() == mesh.positions.size();
+  MinDihedralShortfall r;
+  for (const auto& t : mesh.tets) {
+    if (has_creases && Touches(t, crease_vertex)) continue;
+    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]],
+               &d = mesh.positions[t[3]];
+    const TetQuality q = ComputeTetQuality(a, b, c, d);
+    r.smallest_deg = std::min(r.smallest_deg, q.min_dihedral_deg);
+    if (q.min_dihedral_deg + RoundingSlackDeg(a, b, c, d, q) < min_deg) ++r.num_below;
+  }
+  return r;
 }
 
 QualityReport ComputeQuality(const TetMesh& mesh, const std::vector<uint8_t>& crease_vertex) {

@@ -65,6 +65,17 @@ QualityReport ComputeQuality(const TetMesh& mesh,
 // largest angle). 0 when no tet has a flagged vertex.
 double MaxDihedralLessRounding(const TetMesh& mesh, const std::vector<uint8_t>& flagged_vertex);
 
+// The tets without a crease vertex (crease_vertex as for ComputeQuality)
+// whose smallest dihedral angle is below min_deg even with the rounding
+// allowance of MaxDihedralLessRounding added, and the smallest such angle of
+// all those tets (MeshParams::min_dihedral, core/api.cc).
+struct MinDihedralShortfall {
+  size_t num_below = 0;
+  double smallest_deg = 180;  // 180: no tet without a crease vertex
+};
+MinDihedralShortfall BelowMinDihedral(const TetMesh& mesh, const std::vector<uint8_t>& crease_vertex,
+                                      double min_deg);
+
 // Several lines of text for the CLI ("svrc mesh --stats"); ends with '\n'.
 std::string FormatQualityReport(const QualityReport& report);
 

@@ -139,10 +139,26 @@ struct RefineOptions {
   bool bisector_link_filter = true;
   // With tet_quality, after the refinement (and BreakFlatTets): every kept
   // tet whose smallest dihedral angle is below this many degrees has its
-  // circumcentre destroyed, then Run() again; at most 4 rounds. The flip
-  // pass (sliver.h) fixes most slivers but leaves a few it cannot flip
-  // (docs/svrc-design.md §8 item 38). 0: off.
+  // circumcentre destroyed, then Run() again; at most sliver_break_rounds
+  // rounds. The flip pass (sliver.h) fixes most slivers but leaves a few it
+  // cannot flip (docs/svrc-design.md §8 item 38). 0: off.
+  // core::MeshPlc raises it to MeshParams::min_dihedral (§8 item 69).
   double sliver_break_deg = 5;
+  int sliver_break_rounds = 4;
+  // Where BreakSlivers destroys a sliver (thesis §6.2.1 after Chew 1997 and
+  // Li–Teng 2001; docs/svrc-design.md §8 item 69). 0: at its circumcentre
+  // (item 38). K > 0: the circumcentre, or if the tets its insertion would
+  // make (the cavity's boundary faces joined to it, measured before
+  // inserting) have a dihedral angle below sliver_break_deg, the best of K
+  // more points in the ball of sliver_pick_radius × the circumradius around
+  // it: the largest smallest dihedral angle of its new tets, ties to the
+  // lower index. A point whose Destroy would split a lower ball (a facet
+  // triangle or segment piece: the point strictly inside it) is passed over
+  // while another is not; a sliver whose every point is is left to the flip
+  // pass, as in item 38, unless sliver_yield.
+  int sliver_candidates = 0;
+  double sliver_pick_radius = 0.3;
+  bool sliver_yield = false;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
@@ -377,6 +393,9 @@ struct RefineStats {
   uint64_t stitched_crossings = 0;      // all points for stitched tets crossing a facet (arc points included)
   uint64_t flat_tets_broken = 0;   // near-flat tets of M_Ω broken by an insertion at the end
   uint64_t slivers_broken = 0;     // kept slivers broken by an insertion at the end (per-tet mode)
+  uint64_t sliver_rounds = 0;      // BreakSlivers rounds that broke at least one
+  uint64_t sliver_picks_off_centre = 0;  // ... at a point other than the circumcentre (sliver_candidates)
+  uint64_t sliver_yields_skipped = 0;    // slivers left to the flip pass: every point would split a lower ball
   uint64_t sliver_scan_reused = 0; // tets a later BreakSlivers round skipped: an earlier one found them clear
   std::array<uint64_t, 4> events_pushed{};   // by EventType
   std::array<uint64_t, 4> events_popped{};
