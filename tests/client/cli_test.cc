@@ -137,6 +137,37 @@ TEST_F(CliTest, CollarOptionLocalAndRemoteOutputsAreByteIdentical) {
   fs::remove_all(dir);
 }
 
+// --min-dihedral (docs/svrc-design.md §8 item 69) reaches the server's
+// mesher (the same .svrc bytes locally and remotely, unlike the default's),
+// a target the rounds cannot reach is reported on stderr both ways, a
+// reachable one is not, and one no tet can meet is a usage error.
+TEST_F(CliTest, MinDihedralLocalAndRemoteAndItsWarning) {
+  ASSERT_TRUE(server_->ok());
+  const std::string dir = testing::MakeTempDir("cli_min_dihedral");
+  const std::string input = testing::CorpusPath("e_spread/tiny_cube_in_box.poly");
+  const testing::CommandResult plain = RunSvrc({"mesh", input, "-o", dir + "/plain.svrc", "--quiet"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const testing::CommandResult met =
+      RunSvrc({"mesh", input, "-o", dir + "/met.svrc", "--quiet", "--min-dihedral", "20"});
+  ASSERT_EQ(met.exit_code, 0) << met.err;
+  EXPECT_EQ(met.err.find("warning"), std::string::npos) << met.err;
+  const testing::CommandResult local =
+      RunSvrc({"mesh", input, "-o", dir + "/local.svrc", "--quiet", "--min-dihedral", "35"});
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  EXPECT_NE(local.err.find("warning: "), std::string::npos) << local.err;
+  EXPECT_NE(local.err.find("below min_dihedral 35 degrees"), std::string::npos) << local.err;
+  const testing::CommandResult remote = RunSvrc({"submit", input, "--server", server_->address(), "--watch", "-o",
+                                                 dir + "/remote.svrc", "--min-dihedral", "35"});
+  ASSERT_EQ(remote.exit_code, 0) << remote.err;
+  EXPECT_NE(remote.err.find("below min_dihedral 35 degrees"), std::string::npos) << remote.err;
+  const std::string a = testing::ReadFileOrFail(dir + "/local.svrc");
+  EXPECT_TRUE(a == testing::ReadFileOrFail(dir + "/remote.svrc"));
+  EXPECT_FALSE(a == testing::ReadFileOrFail(dir + "/plain.svrc"));
+  EXPECT_FALSE(a == testing::ReadFileOrFail(dir + "/met.svrc"));
+  EXPECT_EQ(RunSvrc({"mesh", input, "-o", dir + "/x.svrc", "--min-dihedral", "75"}).exit_code, 2);
+  fs::remove_all(dir);
+}
+
 TEST_F(CliTest, SubmitPrintsTheJobIdThenGetListAndHealthWork) {
   ASSERT_TRUE(server_->ok());
   const std::string dir = testing::MakeTempDir("cli_submit");
