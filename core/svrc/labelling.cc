@@ -237,6 +237,33 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       keys[i] = {Sorted3(in.constrained_faces[i].v), static_cast<uint32_t>(i)};
     }
     std::sort(keys.begin(), keys.end());
+    // Without a given face lookup: each key's first record (smallest slot),
+    // each bucket read once and its records looked up among the keys of the
+    // same smallest vertex (a sorted run; the first of equal keys). Scanning
+    // the bucket once per key cost |bucket| × its keys, quadratic in the
+    // degree of a low-id vertex (input vertices have the lowest ids;
+    // crease_pair_0.1deg's output, 10 M vertices).
+    std::vector<uint32_t> key_slot;
+    if (!given) {
+      key_slot.assign(ncf, kNoTet);
+      for (size_t i = 0; i < ncf;) {
+        const uint32_t a = keys[i].first[0];
+        size_t j = i;
+        while (j < ncf && keys[j].first[0] == a) ++j;
+        if (a < nv) {
+          for (const TetFace& f : tet_faces->Bucket(a)) {
+            const std::array<uint32_t, 3> k{a, f.b, f.c};
+            const auto it = std::lower_bound(keys.begin() + i, keys.begin() + j, k,
+                                             [](const auto& e, const std::array<uint32_t, 3>& x) { return e.first < x; });
+            // Records of one face come smallest slot first: keep the first.
+            if (it != keys.begin() + j && it->first == k && key_slot[it - keys.begin()] == kNoTet) {
+              key_slot[it - keys.begin()] = f.slot;
+            }
+          }
+        }
+        i = j;
+      }
+    }
     for (size_t i = 0; i < ncf; ++i) {
       const auto& [k, idx] = keys[i];
       if (k[0] == k[1] || k[1] == k[2]) {
@@ -268,12 +295,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
           first_slot = other != kNoTet ? std::min(s, other) : s;
         }
       } else {
-        for (const TetFace& f : tet_faces->Bucket(k[0])) {
-          if (f.b == k[1] && f.c == k[2]) {
-            first_slot = f.slot;
-            break;
-          }
-        }
+        first_slot = key_slot[i];
       }
       if (first_slot == kNoTet) {
         return absl::InvalidArgumentError(absl::StrCat(

@@ -69,6 +69,39 @@ int32_t ExpectedMarker(const Grid& g, const std::array<uint32_t, 3>& v) {
   return -1;
 }
 
+// crease_pair_0.1deg (session 40): finding each constrained face's slot by
+// scanning the face bucket of its lowest-id vertex once per face cost
+// |bucket| × its faces, quadratic in the degree of an input vertex; now each
+// bucket is read once and its records looked up among the keys. This checks
+// that lookup where it matters, at a vertex in all 60,000 tets and every
+// cone face: every face is found in its one tet, a face that is not in the
+// mesh is named. (The old way took ~5 s here, too little for a timeout to
+// tell; Sliver.ConstraintsAtAVertexOfHighDegreeAreFoundInOnePass does.)
+TEST(LabellingTest, ConstrainedFacesAtAVertexOfHighDegreeAreFoundInOnePass) {
+  std::vector<std::array<uint32_t, 3>> cone;
+  const Grid fan = testing::ApexFan(60000, &cone);
+  std::vector<ConstrainedFace> faces;
+  for (const auto& f : cone) faces.push_back({{f[2], f[0], f[1]}, 7, 0});
+  LabelInput in;
+  in.positions = fan.positions;
+  in.tets = fan.tets;
+  in.constrained_faces = faces;
+  in.keep_bounding_box = true;
+  absl::StatusOr<Labelling> l = LabelRegions(in);
+  ASSERT_TRUE(l.ok()) << l.status();
+  ASSERT_EQ(l->faces.size(), faces.size());
+  for (size_t i = 0; i < faces.size(); ++i) {
+    ASSERT_EQ(l->faces[i].tets[0], i) << "cone face " << i;
+  }
+  EXPECT_EQ(l->components.size(), fan.tets.size());  // the tets share edges, no faces
+  EXPECT_EQ(l->num_kept_tets, fan.tets.size());
+  faces.push_back({{0, 1, 3}, 7, 0});
+  in.constrained_faces = faces;
+  absl::StatusOr<Labelling> bad = LabelRegions(in);
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(bad.status().message().find("(0, 1, 3)"), std::string::npos) << bad.status();
+}
+
 TEST(LabellingTest, NestedBoxesTwoRegionsAndAHole) {
   Nested nb;
   EXPECT_EQ(nb.faces.size(), 6u * (36 + 16 + 4) * 2);

@@ -10,6 +10,30 @@
 
 namespace svrc::refine::testing {
 
+Grid ApexFan(int n, std::vector<std::array<uint32_t, 3>>* cone_faces) {
+  Grid g;
+  g.positions = {{0, 0, 1}};
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    g.positions.push_back({std::cos(a), std::sin(a), 0});
+  }
+  for (int i = 0; i < n; ++i) {
+    const Vec3 p = g.positions[1 + i], q = g.positions[1 + (i + 1) % n];
+    g.positions.push_back({0.45 * (p.x + q.x), 0.45 * (p.y + q.y), 0});
+  }
+  cone_faces->clear();
+  for (int i = 0; i < n; ++i) {
+    std::array<uint32_t, 4> t = {0, static_cast<uint32_t>(1 + i), static_cast<uint32_t>(1 + (i + 1) % n),
+                                 static_cast<uint32_t>(1 + n + i)};
+    if (geom::Orient3d(g.positions[t[0]], g.positions[t[1]], g.positions[t[2]], g.positions[t[3]]) < 0) {
+      std::swap(t[1], t[2]);
+    }
+    g.tets.push_back(t);
+    cone_faces->push_back({0, t[1], t[2]});
+  }
+  return g;
+}
+
 Grid KuhnGrid(int n) {
   Grid g;
   g.n = n;

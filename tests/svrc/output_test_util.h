@@ -31,6 +31,15 @@ struct Grid {
 };
 Grid KuhnGrid(int n);
 
+// n tets with the apex (0, 0, 1) = vertex 0 in common and nothing else but
+// the edges to their neighbours: tet i = (0, r_i, r_{i+1}, m_i), positively
+// oriented, over ring points r_i = 1 .. n on the unit circle and m_i = n+1 ..
+// 2n, 0.9 × the midpoint of r_i r_{i+1}. Vertex 0 (the lowest id) has degree
+// n, every edge at most 2, and vertex 0 is in every cone face (0, r_i,
+// r_{i+1}), as an input vertex at a crease is in a fine mesh's facet
+// triangles (crease_pair_0.1deg, session 40). `cone_faces` gets the n faces.
+Grid ApexFan(int n, std::vector<std::array<uint32_t, 3>>* cone_faces);
+
 // A convex planar polygon (in the mesher's coordinates) with its marker.
 struct ConvexFacet {
   std::vector<Vec3> pts;
