@@ -231,10 +231,9 @@ TEST_F(CliTest, ExitStatuses) {
     EXPECT_EQ(RunSvrc({"submit", points, "--server", addr}).exit_code, 4);
   }
 
-  // A job that fails: PLC meshing is UNIMPLEMENTED for now (5) — or, once it
-  // lands, succeeds (0). A refinement parameter on a point set: 5.
-  const int cube_code = RunSvrc({"submit", cube, "--server", server_->address(), "--watch"}).exit_code;
-  EXPECT_TRUE(cube_code == 5 || cube_code == 0) << cube_code;
+  // A PLC job succeeds (0). A refinement parameter on a point set is
+  // UNIMPLEMENTED: the job fails (5).
+  EXPECT_EQ(RunSvrc({"submit", cube, "--server", server_->address(), "--watch"}).exit_code, 0);
   testing::CommandResult unimpl =
       RunSvrc({"submit", points, "--server", server_->address(), "--watch", "--max-volume", "0.1"});
   EXPECT_EQ(unimpl.exit_code, 5) << unimpl.err;

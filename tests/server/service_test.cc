@@ -2,8 +2,7 @@
 // driven by the C++ client library (client/remote_client.h): submit → watch →
 // fetch → decode, progress events, cancel, N workers, queue full, idempotent
 // resubmission, deadlines, a broken PLC, a PLC's output byte-identical across
-// runs and worker counts, resumable fetch, a 50 MB upload, SIGTERM. Point-set jobs make real meshes; PLC jobs must end SUCCEEDED or
-// FAILED/UNIMPLEMENTED (until PLC meshing lands) — never anything else.
+// runs and worker counts, resumable fetch, a 50 MB upload, SIGTERM. Point-set and PLC jobs make real meshes.
 #include <signal.h>
 
 #include <chrono>
@@ -314,7 +313,7 @@ TEST(ServiceTest, FailedPlcJobCarriesTheMeshersCounters) {
   EXPECT_EQ(again->failure_stats_size(), done->failure_stats_size());
 }
 
-TEST(ServiceTest, PlcJobSucceedsOrIsUnimplementedNeverAnythingElse) {
+TEST(ServiceTest, PlcJobSucceedsWithADecodableMesh) {
   ServerProcess server;
   ASSERT_TRUE(server.ok());
   RemoteClient c(server.address());
@@ -322,15 +321,13 @@ TEST(ServiceTest, PlcJobSucceedsOrIsUnimplementedNeverAnythingElse) {
   ASSERT_TRUE(r.ok()) << r.status();
   absl::StatusOr<v1::Job> done = c.Watch(c.Submit(*r)->job_id(), nullptr);
   ASSERT_TRUE(done.ok());
-  if (done->state() == v1::SUCCEEDED) {
-    absl::StatusOr<cli::FetchedResult> result = c.Fetch(done->job_id());
-    ASSERT_TRUE(result.ok());
-    EXPECT_TRUE(codec::DecodeTetMesh(result->bytes).ok());
-  } else {
-    EXPECT_EQ(done->state(), v1::FAILED);
-    EXPECT_EQ(done->error().code(), static_cast<int>(grpc::StatusCode::UNIMPLEMENTED))
-        << done->error().message();
-  }
+  ASSERT_EQ(done->state(), v1::SUCCEEDED) << done->error().message();
+  absl::StatusOr<cli::FetchedResult> result = c.Fetch(done->job_id());
+  ASSERT_TRUE(result.ok());
+  absl::StatusOr<mesh::TetMesh> m = codec::DecodeTetMesh(result->bytes);
+  ASSERT_TRUE(m.ok()) << m.status();
+  EXPECT_EQ(m->tets.size(), done->result().num_tets());
+  EXPECT_GT(m->tets.size(), 0u);
 }
 
 // Issue #5: byte-identical output across runs and worker counts, for PLCs
