@@ -134,7 +134,7 @@ struct ThreeRing {
 };
 
 // crease_pair_0.1deg (session 40; docs/svrc-collars.md "Session 40"): its
-// 10 M-vertex output spent over an hour in this pass's constraint lookups,
+// 10 M-vertex output was in this pass's constraint lookups when stopped after 9 minutes;
 // which scanned the star (and the face bucket) of each constraint's lowest-id
 // vertex once per constraint: |star| × its constraints, quadratic in the
 // degree of an input vertex. Here vertex 0 is in all 60,000 tets and in every
