@@ -258,9 +258,9 @@ Delaunay3::InsertResult Delaunay3::Insert(const Vec3& p, uint32_t global_id, Tet
 
 // Bowyer–Watson step for the already stored vertex v, from a tet known to
 // conflict with it.
-Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint32_t sos) {
-  const Vec3 p = points_[v];
-  const uint32_t gid = global_ids_[v];
+template <class Conflict>
+void Delaunay3::FloodCavity(uint32_t start, Conflict&& conflict, std::vector<TetId>* cavity,
+                            std::vector<uint32_t>* boundary) const {
   // Marks: tet_bits_ = in the cavity, outside_bits_ = tested, not in
   // conflict. One bit per slot (the sets stay in cache; 32-bit stamps over
   // millions of tets did not), all cleared again below from the lists.
@@ -269,34 +269,68 @@ Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint
   auto test = [](const uint64_t* bits, uint32_t t) { return (bits[t >> 6] >> (t & 63)) & 1; };
   auto set = [](uint64_t* bits, uint32_t t) { bits[t >> 6] |= uint64_t{1} << (t & 63); };
 
-  destroyed_.clear();
-  boundary_.clear();
+  cavity->clear();
+  boundary->clear();
   stack_.clear();
   stack_.push_back(start);
   set(in_cavity, start);
   while (!stack_.empty()) {
     const uint32_t t = stack_.back();
     stack_.pop_back();
-    destroyed_.push_back(TetId(t));
+    cavity->push_back(TetId(t));
     for (uint32_t f = 0; f < 4; ++f) {
       const uint32_t n = tets_[8 * t + 4 + f];
       const uint32_t u = n >> 2;
       if (test(in_cavity, u)) continue;
       if (!test(outside, u)) {
-        if (ConflictRaw(u, p, gid, &sos)) {
+        if (conflict(u)) {
           set(in_cavity, u);
           stack_.push_back(u);
           continue;
         }
         set(outside, u);
       }
-      boundary_.push_back(4 * t + f);
+      boundary->push_back(4 * t + f);
     }
   }
   // Every marked tet is in the cavity or across one of its boundary faces;
-  // set bits belong to this insertion only, so whole words can be zeroed.
-  for (TetId d : destroyed_) in_cavity[d.value() >> 6] = 0;
-  for (uint32_t bf : boundary_) outside[tets_[NRef(bf)] >> 8] = 0;
+  // set bits belong to this flood only, so whole words can be zeroed.
+  for (TetId d : *cavity) in_cavity[d.value() >> 6] = 0;
+  for (uint32_t bf : *boundary) outside[tets_[NRef(bf)] >> 8] = 0;
+}
+
+bool Delaunay3::CavityBoundary(const Vec3& p, uint32_t global_id, TetId start, size_t max_tets,
+                               std::vector<uint32_t>* boundary) const {
+  if (!Is3d() || !start.valid() || start.value() >= TetCapacity() || !IsAlive(start) ||
+      !InConflict(start, p, global_id)) {
+    return false;
+  }
+  // Past max_tets the flood takes no more tets (a conflict then reads as
+  // none), so it ends within the tets it has and their neighbours.
+  bool ghost = IsGhost(start), overflow = false;
+  size_t taken = 1;
+  uint32_t sos = 0;
+  FloodCavity(
+      start.value(),
+      [&](uint32_t u) {
+        if (overflow || !ConflictRaw(u, p, global_id, &sos)) return false;
+        if (++taken > max_tets) {
+          overflow = true;
+          return false;
+        }
+        ghost = ghost || tets_[8 * u + 3] == kInf;
+        return true;
+      },
+      &dry_cavity_, boundary);
+  return !overflow && !ghost;
+}
+
+Delaunay3::InsertResult Delaunay3::InsertVertex(uint32_t v, uint32_t start, uint32_t sos) {
+  const Vec3 p = points_[v];
+  const uint32_t gid = global_ids_[v];
+  FloodCavity(start, [&](uint32_t u) { return ConflictRaw(u, p, gid, &sos); }, &destroyed_, &boundary_);
+  auto test = [](const uint64_t* bits, uint32_t t) { return (bits[t >> 6] >> (t & 63)) & 1; };
+  auto set = [](uint64_t* bits, uint32_t t) { bits[t >> 6] |= uint64_t{1} << (t & 63); };
 
   // An exact duplicate only ever conflicts through the perturbation (p lies
   // on, never strictly inside, the spheres of the tets around its twin).

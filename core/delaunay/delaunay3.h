@@ -139,6 +139,15 @@ class Delaunay3 {
   // circumcircle (perturbed).
   bool InConflict(TetId t, const Vec3& p, uint32_t global_id) const;
 
+  // The faces on the boundary of the cavity that inserting p (priority
+  // global_id) would make, without changing anything: the tets in conflict
+  // with p connected to `start` (which must be one), found as Insert finds
+  // them, each face as the slot 4t + f (face f, opposite vertex f, of cavity
+  // tet t). False when start is not in conflict, a ghost tet is (p beyond the
+  // hull), or the cavity passes max_tets tets.
+  bool CavityBoundary(const Vec3& p, uint32_t global_id, TetId start, size_t max_tets,
+                      std::vector<uint32_t>* boundary) const;
+
   // --- Size and element access -------------------------------------------------
 
   // Vertices ever inserted (including pending ones; duplicates get no id).
@@ -267,6 +276,13 @@ class Delaunay3 {
   InsertResult InsertPending(const Vec3& p, uint32_t global_id);
   void BuildFirstTet(uint32_t a, uint32_t b, uint32_t c, uint32_t d);
   InsertResult InsertVertex(uint32_t v, uint32_t start_conflict, uint32_t sos_used);
+  // Bowyer–Watson's cavity from `start` (in conflict), depth first:
+  // conflict(u) decides each neighbour u once. The cavity's tets go to
+  // *cavity, its boundary faces (4t + f) to *boundary, in the order
+  // InsertVertex makes the new tets in; the bitsets are left zero.
+  template <class Conflict>
+  void FloodCavity(uint32_t start, Conflict&& conflict, std::vector<TetId>* cavity,
+                   std::vector<uint32_t>* boundary) const;
   void LinkAroundApex(uint32_t apex);
   // The star walk behind every vertex query: fills star_buf_ (BFS order from
   // VertexTet(v)) and, with kNeighbors, nbr_buf_ / nbr_tet_buf_; returns the
@@ -312,7 +328,8 @@ class Delaunay3 {
   std::vector<TetId> created_;
   std::vector<VertexId> cavity_vertices_;
   std::vector<uint32_t> boundary_;  // 4t+f of outer faces of the cavity
-  std::vector<uint32_t> stack_;
+  mutable std::vector<uint32_t> stack_;
+  mutable std::vector<TetId> dry_cavity_;  // CavityBoundary's cavity
   std::vector<uint32_t> new_v_;      // per boundary face: the new tet's vertices
   std::vector<uint32_t> new_outer_;  // per boundary face: the outer neighbour 4t+f
   struct EdgeSlot {

@@ -237,12 +237,11 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       keys[i] = {Sorted3(in.constrained_faces[i].v), static_cast<uint32_t>(i)};
     }
     std::sort(keys.begin(), keys.end());
-    // Without a given face lookup: each key's first record (smallest slot),
-    // each bucket read once and its records looked up among the keys of the
-    // same smallest vertex (a sorted run; the first of equal keys). Scanning
-    // the bucket once per key cost |bucket| × its keys, quadratic in the
-    // degree of a low-id vertex (input vertices have the lowest ids;
-    // crease_pair_0.1deg's output, 10 M vertices).
+    // Without a given face lookup: each key's first record (smallest slot).
+    // The keys of one smallest vertex a (a sorted run) are scanned for in a's
+    // bucket, or with more than kConstraintScanRun of them the bucket is read
+    // once and its records looked up in the run (the first of equal keys;
+    // tet_faces.h: crease_pair_0.1deg's output, 10 M vertices).
     std::vector<uint32_t> key_slot;
     if (!given) {
       key_slot.assign(ncf, kNoTet);
@@ -250,7 +249,16 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
         const uint32_t a = keys[i].first[0];
         size_t j = i;
         while (j < ncf && keys[j].first[0] == a) ++j;
-        if (a < nv) {
+        if (j - i <= kConstraintScanRun) {
+          for (size_t r = i; r < j; ++r) {
+            for (const TetFace& f : tet_faces->Bucket(a)) {
+              if (f.b == keys[r].first[1] && f.c == keys[r].first[2]) {
+                key_slot[r] = f.slot;  // records of one face come smallest slot first
+                break;
+              }
+            }
+          }
+        } else {
           for (const TetFace& f : tet_faces->Bucket(a)) {
             const std::array<uint32_t, 3> k{a, f.b, f.c};
             const auto it = std::lower_bound(keys.begin() + i, keys.begin() + j, k,

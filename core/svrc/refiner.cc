@@ -219,8 +219,8 @@ class Refiner {
   // Whether Destroy of q ∈ V(v) yields to a lower ball (BreakSlivers).
   bool YieldsAt(VertexId v, const Vec3& q) const;
   // The smallest dihedral angle of the tets inserting q into M_Ω would
-  // create; t is a tet in conflict with q. -1: t is not, or q's cavity
-  // reaches beyond the hull or past 512 tets.
+  // create (Delaunay3::CavityBoundary from t). -1: t is not in conflict
+  // with q, or q's cavity reaches beyond the hull or past 512 tets.
   double NewTetsMinDihedral(const Vec3& q, TetId t);
   // BreakSlivers' point for the sliver t (circumcentre cc, radius r) under
   // RefineOptions::sliver_candidates, and the vertex whose cell holds it;
@@ -785,9 +785,7 @@ class Refiner {
   std::vector<VertexId> bfs_, nbrs_;
   std::vector<uint32_t> mark_;
   uint32_t stamp_ = 0;
-  std::vector<uint32_t> cavity_mark_;  // NewTetsMinDihedral, per tet slot
-  uint32_t cavity_stamp_ = 0;
-  std::vector<TetId> cavity_tets_;
+  std::vector<uint32_t> cavity_faces_;  // NewTetsMinDihedral
   std::vector<uint32_t> ball_mark_;
   uint32_t ball_stamp_ = 0;
   std::vector<BallId> gathered_;
@@ -3775,47 +3773,20 @@ bool Refiner::YieldsAt(VertexId v, const Vec3& q) const {
 }
 
 double Refiner::NewTetsMinDihedral(const Vec3& q, TetId t) {
-  // Bowyer–Watson's cavity of q, found as Delaunay3::Insert would (the tets
-  // in conflict, connected to t, with q's id as the perturbation's), and
-  // the smallest dihedral angle of the tets q would make with its boundary
-  // faces; nothing is changed.
+  // Bowyer–Watson's cavity of q as Insert would find it (q's id as the
+  // perturbation's), and the smallest dihedral angle of the tets q would
+  // make with its boundary faces; nothing is changed.
   const delaunay::Delaunay3& dt = omega_.dt();
-  const uint32_t gid = points_.size();  // the id the inserted point gets
-  if (!dt.IsAlive(t) || dt.IsGhost(t) || !dt.InConflict(t, q, gid)) return -1;
   constexpr size_t kMaxCavity = 512;
-  if (cavity_mark_.size() < dt.TetCapacity()) cavity_mark_.resize(dt.TetCapacity() + 64, 0);
-  if (cavity_stamp_ > 0xFFFFFFF0u) {
-    std::fill(cavity_mark_.begin(), cavity_mark_.end(), 0);
-    cavity_stamp_ = 0;
-  }
-  const uint32_t in = cavity_stamp_ += 2, out = in + 1;  // in the cavity / tested, not in conflict
-  std::vector<TetId>& cavity = cavity_tets_;
-  cavity.assign(1, t);
-  cavity_mark_[t.value()] = in;
+  if (!dt.CavityBoundary(q, points_.size(), t, kMaxCavity, &cavity_faces_)) return -1;
   double worst = 180;
-  for (size_t i = 0; i < cavity.size(); ++i) {
-    const TetId c = cavity[i];
-    for (int f = 0; f < 4; ++f) {
-      const TetId n = dt.Neighbor(c, f);
-      const uint32_t m = cavity_mark_[n.value()];
-      if (m == in) continue;
-      if (m != out) {
-        if (dt.InConflict(n, q, gid)) {
-          // q beyond the hull: not a point to insert for a sliver.
-          if (dt.IsGhost(n) || cavity.size() >= kMaxCavity) return -1;
-          cavity_mark_[n.value()] = in;
-          cavity.push_back(n);
-          continue;
-        }
-        cavity_mark_[n.value()] = out;
-      }
-      // A boundary face (the face of c opposite vertex f) and q: a new tet.
-      std::array<Vec3, 3> face;
-      for (int k = 0, j = 0; k < 4; ++k) {
-        if (k != f) face[j++] = dt.Point(dt.TetVertex(c, k));
-      }
-      worst = std::min(worst, MeasureSliverTet(face[0], face[1], face[2], q).min_dihedral_deg);
+  for (uint32_t slot : cavity_faces_) {
+    const TetId c(slot / 4);
+    std::array<Vec3, 3> face;
+    for (int k = 0, j = 0; k < 4; ++k) {
+      if (k != static_cast<int>(slot % 4)) face[j++] = dt.Point(dt.TetVertex(c, k));
     }
+    worst = std::min(worst, MeasureSliverTet(face[0], face[1], face[2], q).min_dihedral_deg);
   }
   return worst;
 }

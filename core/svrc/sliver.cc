@@ -360,20 +360,26 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // bucket of their smallest vertex: the flood below then tests a bit, not
   // FaceKey + a binary search over cfaces_ for each of the 4T faces. A face
   // that is not in the mesh marks nothing (CheckConstraints reports it).
-  // Each bucket is read once, its faces looked up among the constrained
-  // faces of the same smallest vertex (a sorted run of cfaces_): scanning
-  // the bucket once per constrained face cost |bucket| × its constrained
-  // faces, quadratic in the degree of a low-id vertex, and input vertices
-  // have the lowest ids (crease_pair_0.1deg's 10 M-vertex output was in this
-  // pass's constraint check when stopped after 9 minutes).
+  // The constrained faces of one smallest vertex a (a sorted run of
+  // cfaces_) are scanned for in a's bucket, or with more than
+  // kConstraintScanRun of them the bucket is read once and its faces looked
+  // up in the run (tet_faces.h; crease_pair_0.1deg's 10 M-vertex output was
+  // in this pass's constraint lookups when stopped after 9 minutes).
   std::vector<uint8_t> constrained(num_tets, 0);
+  auto mark = [&](const TetFace& f) { constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4)); };
   for (size_t i = 0; i < cfaces_.size();) {
     const uint32_t a = cfaces_[i][0];
     size_t j = i;
     while (j < cfaces_.size() && cfaces_[j][0] == a) ++j;
-    for (const TetFace& f : tet_faces->Bucket(a)) {
-      if (std::binary_search(cfaces_.begin() + i, cfaces_.begin() + j, Tri{a, f.b, f.c})) {
-        constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4));
+    if (j - i <= kConstraintScanRun) {
+      for (size_t r = i; r < j; ++r) {
+        for (const TetFace& f : tet_faces->Bucket(a)) {
+          if (f.b == cfaces_[r][1] && f.c == cfaces_[r][2]) mark(f);
+        }
+      }
+    } else {
+      for (const TetFace& f : tet_faces->Bucket(a)) {
+        if (std::binary_search(cfaces_.begin() + i, cfaces_.begin() + j, Tri{a, f.b, f.c})) mark(f);
       }
     }
     i = j;
@@ -428,13 +434,13 @@ absl::Status FlipMesh::CheckConstraints() const {
       if (needed[v]) star[fill[v]++] = static_cast<uint32_t>(t);
     }
   }
-  // Each star is read once: the faces and edges of its tets at its vertex a
-  // are looked up among the constraints whose first vertex is a (a sorted
-  // run), and found ones are marked. Looking each constraint up in the star
-  // instead cost the star's size per constraint, quadratic in the degree of
-  // a low-id vertex (input vertices have the lowest ids; crease_pair_0.1deg
-  // was here when stopped after 9 minutes). The first one missing in sorted order is
-  // reported, as before.
+  // The constraints whose first vertex is a (sorted runs of cfaces_ and
+  // cedges_) are each scanned for in a's star, or with more than
+  // kConstraintScanRun of them the star is read once and the faces and edges
+  // of its tets at a are looked up in the runs (tet_faces.h;
+  // crease_pair_0.1deg was here when stopped after 9 minutes). The first
+  // one missing in sorted order is reported.
+  auto has = [&](const Tet& t, uint32_t v) { return t[0] == v || t[1] == v || t[2] == v || t[3] == v; };
   std::vector<uint8_t> face_found(cfaces_.size(), 0), edge_found(cedges_.size(), 0);
   for (size_t i = 0, ie = 0; i < cfaces_.size() || ie < cedges_.size();) {
     const uint32_t a = std::min(i < cfaces_.size() ? cfaces_[i][0] : UINT32_MAX,
@@ -442,6 +448,21 @@ absl::Status FlipMesh::CheckConstraints() const {
     size_t j = i, je = ie;
     while (j < cfaces_.size() && cfaces_[j][0] == a) ++j;
     while (je < cedges_.size() && cedges_[je][0] == a) ++je;
+    if ((j - i) + (je - ie) <= kConstraintScanRun) {
+      for (size_t r = i; r < j; ++r) {
+        for (uint32_t k = start[a]; k < start[a + 1] && !face_found[r]; ++k) {
+          face_found[r] = has(tet_[star[k]], cfaces_[r][1]) && has(tet_[star[k]], cfaces_[r][2]);
+        }
+      }
+      for (size_t r = ie; r < je; ++r) {
+        for (uint32_t k = start[a]; k < start[a + 1] && !edge_found[r]; ++k) {
+          edge_found[r] = has(tet_[star[k]], cedges_[r][1]);
+        }
+      }
+      i = j;
+      ie = je;
+      continue;
+    }
     for (uint32_t k = start[a]; k < start[a + 1]; ++k) {
       const Tet& t = tet_[star[k]];
       std::array<uint32_t, 3> other;  // t's vertices but a, ascending

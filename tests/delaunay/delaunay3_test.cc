@@ -103,6 +103,58 @@ std::vector<uint32_t> Shuffled(size_t n, uint32_t seed) {
   return o;
 }
 
+// CavityBoundary (the dry run BreakSlivers scores candidate points with,
+// docs/svrc-design.md §8 item 69) reports exactly the faces Insert then
+// joins to the new point: as many, with the same vertex sets, and nothing
+// in the mesh changes in between. Beyond the hull, from a tet not in
+// conflict, or past max_tets: false.
+TEST(Delaunay3Test, CavityBoundaryIsTheFacesInsertJoins) {
+  const std::vector<Vec3> pts = RandomPoints(400, 11);
+  Delaunay3 dt;
+  for (uint32_t i = 0; i < 300; ++i) dt.Insert(pts[i], i);
+  std::vector<uint32_t> boundary;
+  for (uint32_t i = 300; i < 400; ++i) {
+    const TetId start = dt.Locate(pts[i]);
+    ASSERT_TRUE(start.valid());
+    const std::vector<Tet> before = CanonicalTets(dt);
+    if (dt.IsGhost(start)) {
+      EXPECT_FALSE(dt.CavityBoundary(pts[i], i, start, 1000, &boundary)) << i;
+      dt.Insert(pts[i], i);
+      continue;
+    }
+    ASSERT_TRUE(dt.CavityBoundary(pts[i], i, start, 1000, &boundary)) << i;
+    EXPECT_EQ(CanonicalTets(dt), before) << "the dry run changed the mesh at point " << i;
+    std::multiset<std::array<uint32_t, 3>> faces;
+    for (uint32_t slot : boundary) {
+      std::array<uint32_t, 3> f;
+      for (int k = 0, j = 0; k < 4; ++k) {
+        if (k != static_cast<int>(slot % 4)) f[j++] = dt.TetVertex(TetId(slot / 4), k).value();
+      }
+      std::sort(f.begin(), f.end());
+      faces.insert(f);
+    }
+    if (faces.size() > 4) {
+      EXPECT_FALSE(dt.CavityBoundary(pts[i], i, start, 1, &boundary)) << i;  // more than one tet
+    }
+    const auto r = dt.Insert(pts[i], i, start);
+    ASSERT_EQ(r.outcome, Delaunay3::InsertOutcome::kInserted);
+    std::multiset<std::array<uint32_t, 3>> joined;
+    for (TetId t : r.created) {
+      std::array<uint32_t, 3> f;
+      for (int k = 0, j = 0; k < 4; ++k) {
+        if (dt.TetVertex(t, k) != r.vertex) f[j++] = dt.TetVertex(t, k).value();
+      }
+      std::sort(f.begin(), f.end());
+      joined.insert(f);
+    }
+    EXPECT_EQ(faces, joined) << "point " << i;
+  }
+  // A tet the point is not in conflict with (far from it).
+  const Vec3 far_point(10, 10, 10);
+  EXPECT_FALSE(dt.CavityBoundary(Vec3(0.5, 0.5, 0.5), 1000, dt.Locate(far_point), 1000, &boundary));
+  EXPECT_TRUE(dt.Validate(true).ok());
+}
+
 TEST(Delaunay3Test, EmptyAndPending) {
   Delaunay3 dt;
   EXPECT_FALSE(dt.Is3d());
