@@ -439,6 +439,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
     options.sliver_break_rounds = 32;
     options.sliver_candidates = 16;
     options.sliver_yield = true;
+    options.sliver_ramp_deg = 5;
   }
   // With the box as facets nothing is outside the domain but what lies
   // outside the box (refine's Ω is now larger than it).

@@ -4537,34 +4537,62 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
     if (!s.ok()) return s;
   }
   // Slivers of the per-tet mode's output (§8 item 38), a few rounds, until
-  // one breaks none. With candidate points (min_dihedral, §8 item 69) also
-  // until they stop gaining: 4 rounds without a new fewest slivers broken,
-  // or 1.5× (+1000) the vertices the rounds started with, or half the
-  // budget. Measured: below ~25° the count falls every round or nearly
-  // (cube --max-volume 1e-5 at 22°: 8,237, 916, 201, 75, 14, 8, 6, 0, +5%
-  // vertices); at 28° it stops falling after 9 rounds and grows (2,740 →
-  // 4,471 by round 30, the vertices 47 k → 124 k).
+  // one breaks none. With candidate points (min_dihedral, §8 item 69) the
+  // target rises in steps of sliver_ramp_deg from min(15°, D) to D, each
+  // level's rounds until one breaks none; a level that stops gaining ends
+  // them all: 4 rounds without a new fewest slivers broken, or 1.5× (+1000)
+  // the vertices the rounds started with, or half the budget. Measured:
+  // below ~25° the count falls every round or nearly (cube --max-volume 1e-5
+  // at 22° straight: 8,237, 916, 201, 75, 14, 8, 6, 0, +5% vertices); at 28°
+  // it stops falling after 9 rounds and grows (2,740 → 4,471 by round 30,
+  // the vertices 47 k → 124 k). Straight to an unreachable target, the last
+  // round's new slivers could leave the smallest angle below the default's
+  // (example.poly at 35°: 7.57° against 9.96°); the levels keep what the
+  // last level reached.
   const uint64_t sliver_start = refiner.Vertices();
-  uint64_t fewest = UINT64_MAX;
-  int since_fewest = 0;
-  for (int round = 0; tet_quality && !collar_tets && options.sliver_break_deg > 0 &&
-                      round < options.sliver_break_rounds;
-       ++round) {
-    absl::StatusOr<uint64_t> broken = refiner.BreakSlivers(options.sliver_break_deg, /*first=*/round == 0);
-    if (!broken.ok()) return broken.status();
-    if (*broken == 0) break;
-    s = refiner.Run();
-    if (!s.ok()) return s;
-    if (options.sliver_candidates > 0) {
-      if (*broken < fewest) {
-        fewest = *broken;
-        since_fewest = 0;
-      } else if (++since_fewest >= 4) {
-        break;
+  const bool ramp = options.sliver_candidates > 0 && options.sliver_ramp_deg > 0;
+  double level = ramp ? std::min(15.0, options.sliver_break_deg) : options.sliver_break_deg;
+  double reached = 0;  // the last level whose rounds ended breaking none
+  bool cleanup = false;
+  int rounds = 0;
+  for (bool gaining = true; tet_quality && !collar_tets && options.sliver_break_deg > 0;) {
+    uint64_t fewest = UINT64_MAX;
+    int since_fewest = 0;
+    for (int round = 0; rounds < options.sliver_break_rounds; ++round, ++rounds) {
+      // A new level re-reads the tets an earlier one found clear.
+      absl::StatusOr<uint64_t> broken = refiner.BreakSlivers(level, /*first=*/round == 0);
+      if (!broken.ok()) return broken.status();
+      if (*broken == 0) break;
+      s = refiner.Run();
+      if (!s.ok()) return s;
+      if (options.sliver_candidates > 0) {
+        if (*broken < fewest) {
+          fewest = *broken;
+          since_fewest = 0;
+        } else if (++since_fewest >= 4) {
+          gaining = false;
+          break;
+        }
+        const uint64_t v = refiner.Vertices();
+        if (2 * v > 3 * sliver_start + 2000 || 2 * v > refiner.VertexBudget()) {
+          gaining = false;
+          break;
+        }
       }
-      const uint64_t v = refiner.Vertices();
-      if (2 * v > 3 * sliver_start + 2000 || 2 * v > refiner.VertexBudget()) break;
     }
+    if (!ramp || rounds >= options.sliver_break_rounds || cleanup) break;
+    if (!gaining) {
+      // The level that stopped gaining left new slivers below the last level
+      // reached: its rounds again (they ended breaking none once).
+      if (reached == 0) break;
+      level = reached;
+      cleanup = true;
+      gaining = true;
+      continue;
+    }
+    reached = level;
+    if (level >= options.sliver_break_deg) break;
+    level = std::min(level + options.sliver_ramp_deg, options.sliver_break_deg);
   }
   int crossing_passes = 0, size_passes = 0, stitch_repair_passes = 0;
   for (int stitch_pass = 0;; ++stitch_pass) {

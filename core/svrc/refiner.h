@@ -159,6 +159,9 @@ struct RefineOptions {
   int sliver_candidates = 0;
   double sliver_pick_radius = 0.3;
   bool sliver_yield = false;
+  // With sliver_candidates: the rounds' target rises from min(15°,
+  // sliver_break_deg) in steps of this many degrees (0: straight to it).
+  double sliver_ramp_deg = 0;
   // Work of the rounds run whenever the queues run dry, reused while what it
   // read is unchanged: each collar ball's restricted Delaunay of S
   // (CollarRestrictionCache), each facet's settled arc check, each simplex
