@@ -300,6 +300,28 @@ TEST(CreaseMesh, FacetPair1) {
   EXPECT_EQ(out.stats.Get("svrc.collar_snap", -1), 0);
 }
 
+// Two facets at 0.1° (LONG_: ~72 min wall and 16.7 GB beside other work,
+// 3,053 s CPU; session 40): the wedge between them needs tets of the gap's
+// size, ~1/α² of them (docs/svrc-collars.md "Session 16"), so 16.2 M vertices
+// in all meshes, past the default budget (10^6, which refuses it with its
+// message); a cap of 20 M here. Sessions 16 and 24 stopped in the first
+// refinement (memory, deadline); session 40's first run reached the output
+// and sat in the sliver pass's constraint lookups, quadratic in the degree of
+// an input vertex (fixed: Sliver.ConstraintsAtAVertexOfHighDegreeAreFoundInOnePass).
+// Measured by the CLI run of the same input: 10,038,812 vertices, 61,443,063
+// tets, radius-edge 1.99999894 away from the creases, largest dihedral next
+// to them 154.46° (stitched bound 160.92°), σ ≤ 60°, no snap.
+TEST(CreaseMesh, LONG_FacetPairTenthOfADegree) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "release only";
+#endif
+  core::MeshParams params;
+  params.max_vertices = 20000000;
+  const CreaseMeshed out = MeshAndCheck(plc::families::CreaseFacetPair(0.1), "crease_pair_0.1", params);
+  EXPECT_GT(out.tets, 50000000u);
+  EXPECT_EQ(out.stats.Get("svrc.collar_snap", -1), 0);
+}
+
 // A creased input at a radius-edge bound the collar path cannot reach within
 // the vertex budget (knife_edge.poly: 44,608 tets at 1.65 and 650,464 at 1.5
 // in sessions 26-28; a 30,000-vertex budget here) ends FAILED_PRECONDITION
