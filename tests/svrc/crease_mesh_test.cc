@@ -300,8 +300,8 @@ TEST(CreaseMesh, FacetPair1) {
   EXPECT_EQ(out.stats.Get("svrc.collar_snap", -1), 0);
 }
 
-// Two facets at 0.1° (LONG_: ~72 min wall and 16.7 GB beside other work,
-// 3,053 s CPU; session 40): the wedge between them needs tets of the gap's
+// Two facets at 0.1° (LONG_: passed in 2,766 s on an idle box, ~17 GB;
+// session 40): the wedge between them needs tets of the gap's
 // size, ~1/α² of them (docs/svrc-collars.md "Session 16"), so 16.2 M vertices
 // in all meshes, past the default budget (10^6, which refuses it with its
 // message); a cap of 20 M here. Sessions 16 and 24 stopped in the first
