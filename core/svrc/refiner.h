@@ -422,6 +422,7 @@ struct RefineStats {
   std::array<uint64_t, kNumLinkChangeKinds> insertions_by_kind{};
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
+  uint64_t sizes_certified_partial = 0;  // ... of them next to the output's boundary (session 41)
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)
   uint64_t size_queries = 0;       // M_Ω Size() calls (and ShrunkSize answers)

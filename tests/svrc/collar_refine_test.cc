@@ -342,6 +342,7 @@ struct SameRefinementCase {
   const char* rel;
   bool collars;
   double max_volume;
+  bool cell_test = false;  // RefineOptions::tet_quality off: Figure 3.5's cell test throughout
 };
 std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase& c,
                                                         const std::function<void(RefineOptions*, bool)>& set) {
@@ -358,6 +359,7 @@ std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase
     opt.collar_surface = c.collars;
     opt.max_rep_angle = 60 * M_PI / 180;
     opt.max_volume = c.max_volume;
+    if (c.cell_test) opt.tet_quality = false;
     set(&opt, on == 1);
     absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
     EXPECT_TRUE(run.ok()) << c.rel << ": " << run.status();
@@ -384,17 +386,30 @@ std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase
 // 6617 output vertices); cube.poly with max_volume exercises size targets.
 // The same switch turns on OmegaMesh::ShrunkSize (cavity cells sized from
 // their memo when their farthest corner survived), which must not change
-// the refinement either.
+// the refinement either. Since session 41 cells with star tets on both sides
+// of the output's boundary are certified too (over their kept tets): the
+// cube's boundary cells take that path (CellCert::partial), here also under
+// Figure 3.5's cell test (tet_quality off), where IsBad reads τ·r_v. On
+// these inputs no such cell's bound ever exceeded τ·r_v or a size target
+// (checked against Size() in session 41), so the test shows the same
+// refinement and that the path is taken, not that each of its conditions
+// is needed; docs/svrc-design.md §8 item 70 argues them.
 TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
   if (kSanitized) GTEST_SKIP() << "release only";
   for (const SameRefinementCase& c :
        {SameRefinementCase{"d_small_angles/segment_fan.poly", true, 0}, SameRefinementCase{"a_convex/cube.poly", false, 1e-4},
-        SameRefinementCase{"b_internal/box_in_box.poly", false, 0}}) {
+        SameRefinementCase{"b_internal/box_in_box.poly", false, 0},
+        SameRefinementCase{"a_convex/cube.poly", false, 1e-4, /*cell_test=*/true},
+        SameRefinementCase{"b_internal/box_internal_facet.poly", false, 1e-4, /*cell_test=*/true}}) {
     const auto runs = RefineTwiceAndCompare(c, [](RefineOptions* o, bool on) { o->certify_cells = on; });
     EXPECT_EQ(runs[0].stats.sizes_certified, 0u) << c.rel;
     EXPECT_EQ(runs[0].stats.sizes_shrunk, 0u) << c.rel;
     EXPECT_GT(runs[1].stats.sizes_certified, 500u) << c.rel;
     EXPECT_GT(runs[1].stats.sizes_shrunk, 500u) << c.rel;
+    EXPECT_EQ(runs[0].stats.sizes_certified_partial, 0u) << c.rel;
+    if (c.max_volume > 0) {
+      EXPECT_GT(runs[1].stats.sizes_certified_partial, c.cell_test ? 300u : 1000u) << c.rel << (c.cell_test ? " (cell test)" : "");
+    }
   }
 }
 
