@@ -189,6 +189,10 @@ class FacetMesh {
   std::vector<uint32_t> cell_gen_;
   std::vector<EventHandle> skinny_event_, unresolved_event_;
   std::vector<BallId> tri_ball_;  // by triangle slot; kNoneBall: none
+  // InFacet of each live triangle, by slot, as SyncTriangleBalls and
+  // CreateAllTriangleBalls found it (InFacetTriangles reads it).
+  static constexpr uint8_t kInFacetUnknown = 0, kInFacetNo = 1, kInFacetYes = 2;
+  std::vector<uint8_t> in_facet_;
   std::vector<int32_t> on_segment_;  // per vertex: region segment it lies on, -1: none
   mutable std::vector<Delaunay2::TriId> star_;
   mutable std::vector<VertexId2> nbrs_;

@@ -2,6 +2,7 @@
 // "triangle in F" (guide §5 item 4), Delaunay validity of M_F inside Ω_F, and
 // clipped cell sizes. The in-facet triangles must cover F exactly (area) when
 // F's segments are edges of M_F, and cover it (area ≥) in any case.
+#include <array>
 #include <cmath>
 #include <set>
 #include <utility>
@@ -163,6 +164,7 @@ bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double face
   double in_area = 0;
   int in_count = 0;
   int corner_touching = 0;
+  std::vector<std::array<PointId, 3>> in_tris;  // InFacet over every live triangle, recomputed
   for (auto t : dt.Triangles()) {
     const Vec2 a = dt.Point(dt.TriVertex(t, 0)), b = dt.Point(dt.TriVertex(t, 1)),
                c = dt.Point(dt.TriVertex(t, 2));
@@ -172,11 +174,16 @@ bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double face
       edges.insert({std::min(u, w), std::max(u, w)});
     }
     if (!mesh.InFacet(t)) continue;
+    in_tris.push_back({mesh.PointOf(dt.TriVertex(t, 0)), mesh.PointOf(dt.TriVertex(t, 1)),
+                       mesh.PointOf(dt.TriVertex(t, 2))});
     ++in_count;
     in_area += Area(a, b, c);
     for (int i = 0; i < 3; ++i) corner_touching += dt.IsCorner(dt.TriVertex(t, i));
   }
+  // InFacetTriangles reads the flags SyncTriangleBalls recorded (session 41):
+  // the same triangles, in the same order, as testing each one again.
   EXPECT_EQ(static_cast<size_t>(in_count), mesh.InFacetTriangles().size());
+  EXPECT_EQ(mesh.InFacetTriangles(), in_tris);
   bool conforming = true;
   for (const auto& s : region.segment_points) {
     const uint32_t u = s[0].value(), w = s[1].value();
