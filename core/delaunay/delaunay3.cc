@@ -881,14 +881,20 @@ VertexId Delaunay3::VertexAt(const Vec3& p, TetId hint) const {
   return kNoneVertex;
 }
 
-Vec3 Delaunay3::Circumcenter(TetId t) const {
+Vec3 Delaunay3::Circumcenter(TetId t, TetShape* shape) const {
   const uint32_t* v = &tets_[8 * t.value()];
   const Vec3 a = points_[v[0]];
   const Vec3 b = points_[v[1]] - a, c = points_[v[2]] - a, d = points_[v[3]] - a;
   // Relative to a: x = (|b|²(c×d) + |c|²(d×b) + |d|²(b×c)) / (2 b·(c×d)).
   const Vec3 cd = geom::Cross(c, d), db = geom::Cross(d, b), bc = geom::Cross(b, c);
-  const double den = 2.0 * geom::Dot(b, cd);
-  const Vec3 num = geom::Norm2(b) * cd + geom::Norm2(c) * db + geom::Norm2(d) * bc;
+  const double det = geom::Dot(b, cd);
+  const double den = 2.0 * det;
+  const double b2 = geom::Norm2(b), c2 = geom::Norm2(c), d2 = geom::Norm2(d);
+  const Vec3 num = b2 * cd + c2 * db + d2 * bc;
+  if (shape != nullptr) {
+    shape->det = det;
+    shape->longest2 = std::max({b2, c2, d2, geom::Dist2(b, c), geom::Dist2(b, d), geom::Dist2(c, d)});
+  }
   return a + num / den;
 }
 

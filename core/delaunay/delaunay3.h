@@ -237,7 +237,16 @@ class Delaunay3 {
   // --- Tet constructions (finite tets) -----------------------------------------
 
   // Circumcentre of finite tet t, computed relative to its vertex 0.
-  Vec3 Circumcenter(TetId t) const;
+  Vec3 Circumcenter(TetId t) const { return Circumcenter(t, nullptr); }
+  // The same, and what the computation has at hand for a shape test: with
+  // b, c, d the edge vectors from vertex 0, det = b·(c×d) (six times the
+  // signed volume) and longest2 the largest of |b|², |c|², |d|², |b − c|²,
+  // |b − d|², |c − d|² (OmegaMesh's flatness test, which read them again).
+  struct TetShape {
+    double det = 0;
+    double longest2 = 0;
+  };
+  Vec3 Circumcenter(TetId t, TetShape* shape) const;
   // Circumradius of finite tet t (distance from the circumcentre to vertex 0).
   double Circumradius(TetId t) const;
 

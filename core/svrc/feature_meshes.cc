@@ -94,14 +94,14 @@ void GrowTable(util::PodVector<R>& table, uint32_t key, size_t n, uint32_t limit
 OmegaMesh::CcEntry OmegaMesh::ComputeCircumcenter(TetId t) const {
   ++stats_.circumcentres;
   CcEntry e;
-  e.cc = dt_.Circumcenter(t);
+  // |b·(c×d)| and the longest squared edge from the circumcentre's own
+  // computation (the same doubles as recomputing them from the vertices).
+  delaunay::Delaunay3::TetShape shape;
+  e.cc = dt_.Circumcenter(t, &shape);
   e.inside = InsideCube(e.cc);
   const Vec3& a = dt_.Point(dt_.TetVertex(t, 0));
-  const Vec3 ab = dt_.Point(dt_.TetVertex(t, 1)) - a, ac = dt_.Point(dt_.TetVertex(t, 2)) - a,
-             ad = dt_.Point(dt_.TetVertex(t, 3)) - a;
-  const double vol6 = std::fabs(geom::Dot(ab, geom::Cross(ac, ad)));
-  const double l2 = std::max({geom::Norm2(ab), geom::Norm2(ac), geom::Norm2(ad), geom::Dist2(ab, ac),
-                              geom::Dist2(ab, ad), geom::Dist2(ac, ad)});
+  const double vol6 = std::fabs(shape.det);
+  const double l2 = shape.longest2;
   double scale = 0;
   for (int k = 0; k < 3; ++k) scale = std::max({scale, std::fabs(a[k]), std::fabs(e.cc[k])});
   e.flat = vol6 <= 1e-9 * l2 * std::sqrt(l2) + 3e-14 * l2 * std::min(scale, 4.0 * half_side_);

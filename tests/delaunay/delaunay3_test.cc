@@ -458,11 +458,23 @@ TEST(Delaunay3Test, QueriesMatchBruteForce) {
       EXPECT_EQ(geom::Dist(far, pts[v]), R);
     }
   }
-  // Circumcentres are equidistant from the four vertices.
+  // Circumcentres are equidistant from the four vertices. The shape the
+  // computation reports (session 41; OmegaMesh's flatness test reads it) is
+  // the same doubles as computing it again from the vertices.
   for (TetId t : dt.FiniteTets()) {
     const Vec3 c = dt.Circumcenter(t);
     const double r = dt.Circumradius(t);
     for (int i = 0; i < 4; ++i) EXPECT_NEAR(geom::Dist(c, dt.Point(dt.TetVertex(t, i))), r, 1e-9 * (1 + r));
+    Delaunay3::TetShape shape;
+    const Vec3 c2 = dt.Circumcenter(t, &shape);
+    EXPECT_TRUE(c2.x == c.x && c2.y == c.y && c2.z == c.z);
+    const Vec3& a = dt.Point(dt.TetVertex(t, 0));
+    const Vec3 b = dt.Point(dt.TetVertex(t, 1)) - a, cc = dt.Point(dt.TetVertex(t, 2)) - a,
+               d = dt.Point(dt.TetVertex(t, 3)) - a;
+    EXPECT_EQ(shape.det, geom::Dot(b, geom::Cross(cc, d)));
+    EXPECT_GT(shape.det, 0);  // positively oriented
+    EXPECT_EQ(shape.longest2, std::max({geom::Norm2(b), geom::Norm2(cc), geom::Norm2(d), geom::Dist2(b, cc),
+                                        geom::Dist2(b, d), geom::Dist2(cc, d)}));
   }
   // Nearest vertex and point location.
   const auto queries = RandomPoints(500, 13);
