@@ -80,9 +80,8 @@ bool BallBeyondBisector(double xc2, double yc2, double xy, double r, double scal
 // at or below that is "may meet" without the square root. Bit for bit
 // BallBeyondBisector(xc2, yc2, Dist(x, y), r, scale2).
 bool BallBeyondBisectorOf(double xc2, double yc2, const Vec3& x, const Vec3& y, double r, double scale2) {
-  const double lhs = xc2 - yc2;
-  if (!(lhs > 1e-12 * scale2)) return false;
-  return lhs > 2.0 * r * geom::Dist(x, y) * (1 + 1e-9) + 1e-12 * scale2;
+  if (!(xc2 - yc2 > 1e-12 * scale2)) return false;
+  return BallBeyondBisector(xc2, yc2, geom::Dist(x, y), r, scale2);
 }
 // A deterministic offset in [−1, 1) from a point id (splitmix64): the
 // Steiner points of facet and segment meshes are moved off the exact
@@ -601,7 +600,11 @@ class Refiner {
   static constexpr uint32_t kTetEvent = 1u << 31;
   // Skinny, or larger than the size target of max_volume (SetSizeTargets).
   bool IsBad(VertexId v, const CellSize& s) const {
-    return IsSkinny(s) || (v.value() < size_target_.size() && s.kept_outradius > size_target_[v.value()]);
+    return IsSkinny(s) || AboveSizeTarget(v, s.kept_outradius);
+  }
+  // A kept corner at distance R exceeds v's size target (max_volume).
+  bool AboveSizeTarget(VertexId v, double R) const {
+    return v.value() < size_target_.size() && R > size_target_[v.value()];
   }
   bool IsSkinny(const SegmentMesh::Size1& s) const { return s.outradius > options_.tau * s.inradius; }
   // Facet meshes: Voronoi aspect bound facet_tau_factor·τ (RefineOptions).
@@ -1884,8 +1887,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
       }
       if (cert.valid && !new_at_[i].outside) {
         const double m = new_at_[i].corner;
-        const bool target = u.value() < size_target_.size();
-        if (!(m > CellTau() * r) && !(target && m > size_target_[u.value()]) &&
+        if (!(m > CellTau() * r) && !AboveSizeTarget(u, m) &&
             (r == cert.inradius || !(cert.outradius > CellTau() * r))) {
           cert.inradius = r;
           exact[i] = 0;
@@ -1905,8 +1907,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
       // 16,581 Size() calls for old cavity vertices (session 41).
       if (cert.partial && !new_at_[i].all_outside && new_at_[i].corner <= cert.outradius) {
         const double m = std::max(cert.kept, new_at_[i].kept_corner);
-        const bool target = u.value() < size_target_.size();
-        if (!(m > CellTau() * r) && !(target && m > size_target_[u.value()])) {
+        if (!(m > CellTau() * r) && !AboveSizeTarget(u, m)) {
           cert.inradius = r;
           cert.kept = m;
           exact[i] = 0;

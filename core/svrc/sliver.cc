@@ -27,6 +27,9 @@ using Edge = std::array<uint32_t, 2>;
 
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// A tet's six edges by vertex position; edge 5 − k joins the two vertices
+// edge k misses.
+constexpr int kTetEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
 Tri SortedTri(uint32_t a, uint32_t b, uint32_t c) {
   Tri t{a, b, c};
@@ -104,9 +107,10 @@ Quality MeasureInput(std::span<const Vec3> pos, Tet t, double sin_target) {
   Quality out{0, 0, q.radius_edge, q.volume};
   if (sin_target > 0) {
     const Vec3 p[4] = {a, b, c, d};
-    double longest2 = 0;
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i + 1; j < 4; ++j) longest2 = std::max(longest2, geom::Dist2(p[i], p[j]));
+    double e2[6], longest2 = 0;
+    for (int k = 0; k < 6; ++k) {
+      e2[k] = geom::Dist2(p[kTetEdge[k][0]], p[kTetEdge[k][1]]);
+      longest2 = std::max(longest2, e2[k]);
     }
     if (6 * q.volume > longest2 * std::sqrt(longest2) * sin_target * (1 + 1e-6)) {
       out.dihedrals = false;
@@ -128,17 +132,8 @@ Quality MeasureInput(std::span<const Vec3> pos, Tet t, double sin_target) {
     const double lhs = det * det;
     const double rhs = sin_target * sin_target * (1 + 1e-6);
     bool all = std::isfinite(lhs) && lhs > 0;
-    for (int i = 0; i < 4 && all; ++i) {
-      for (int j = i + 1; j < 4 && all; ++j) {
-        // Edge ij lies on the two faces not opposite i or j: those opposite
-        // the other two vertices k, l.
-        int k = 0;
-        while (k == i || k == j) ++k;
-        int l = k + 1;
-        while (l == i || l == j) ++l;
-        all = lhs * geom::Dist2(p[i], p[j]) > rhs * nn[k] * nn[l];
-      }
-    }
+    // Edge k lies on the faces opposite the two vertices it misses (edge 5 − k).
+    for (int k = 0; k < 6 && all; ++k) all = lhs * e2[k] > rhs * nn[kTetEdge[5 - k][0]] * nn[kTetEdge[5 - k][1]];
     if (all) {
       out.dihedrals = false;
       return out;
@@ -1154,7 +1149,6 @@ namespace {
 // expressions of mesh::ComputeTetQuality (core/mesh/quality.cc), in the same
 // order (-ffp-contract=off: the same roundings), so every value is the same
 // double; the pass's stats and the output's quality report agree.
-constexpr int kTetEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
 void MeasureBounds(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, SliverTetQuality* out) {
   const Vec3 p[4] = {a, b, c, d};
