@@ -246,8 +246,11 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   std::string kinds;
   for (int k = 0; k < refine::kNumLinkChangeKinds; ++k) {
     absl::StrAppend(&kinds, " lk_", refine::kLinkChangeKindName[k], "=", s.link_changes_by_kind[k], " in_",
-                    refine::kLinkChangeKindName[k], "=", s.insertions_by_kind[k]);
+                    refine::kLinkChangeKindName[k], "=", s.insertions_by_kind[k], " sec_",
+                    refine::kLinkChangeKindName[k], "=", s.seconds_by_kind[k], " ev_", refine::kLinkChangeKindName[k],
+                    "=", s.events_by_kind[k]);
   }
+  absl::StrAppend(&kinds, " sec_other_events=", s.seconds_other_events, " other_events=", s.other_events);
   std::printf(
       "RESULT status=OK out_vertices=%zu out_tets=%zu omega_vertices=%llu omega_tets=%zu "
       "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu destroy_index=%llu links_added=%llu "
@@ -531,6 +534,39 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
       const double n = r.r.D("in_" + name);
       std::printf(" %s (%s%%)", n > 0 ? F(r.r.D("lk_" + name) / n, 1).c_str() : "-", F(100 * n / ins, 1).c_str());
     }
+  }
+  std::printf("\n");
+  // The refinement loop's time per event by the same kinds
+  // (RefineStats::seconds_by_kind: an event's wall time goes to the
+  // lowest-dimensional mesh it inserted into, else its M_Ω insertion's
+  // kind), each kind's share of the loop's time, and the spread of each
+  // kind's µs per event over the runs: flat per kind while the mix moves is
+  // the thesis' output-sensitive cost.
+  std::printf("  - refinement loop µs per event by kind (share of the loop's time; events of no kind: share); spread over the runs:");
+  for (int k = 0; k < refine::kNumLinkChangeKinds; ++k) {
+    const std::string name = refine::kLinkChangeKindName[k];
+    std::printf("%s %s", k == 0 ? "" : ";", name.c_str());
+    double lo = HUGE_VAL, hi = 0;
+    for (const Row& r : rows) {
+      if (r.r.status != "OK") continue;
+      double loop = r.r.D("sec_other_events");
+      for (const char* kn : refine::kLinkChangeKindName) loop += r.r.D(std::string("sec_") + kn);
+      const double n = r.r.D("ev_" + name);
+      const double us = n > 0 ? 1e6 * r.r.D("sec_" + name) / n : 0;
+      if (n >= 100) {  // a kind with a handful of events says nothing about its cost
+        lo = std::min(lo, us);
+        hi = std::max(hi, us);
+      }
+      std::printf(" %s (%s%%)", n > 0 ? F(us, 1).c_str() : "-", F(loop > 0 ? 100 * r.r.D("sec_" + name) / loop : 0, 1).c_str());
+    }
+    if (hi > 0) std::printf(" ×%s", F(hi / lo, 2).c_str());
+  }
+  std::printf("; no kind");
+  for (const Row& r : rows) {
+    if (r.r.status != "OK") continue;
+    double loop = r.r.D("sec_other_events");
+    for (const char* kn : refine::kLinkChangeKindName) loop += r.r.D(std::string("sec_") + kn);
+    std::printf(" %s%%", F(loop > 0 ? 100 * r.r.D("sec_other_events") / loop : 0, 1).c_str());
   }
   std::printf("\n");
 }

@@ -3,6 +3,7 @@
 // the thesis'. See refiner.h and docs/svrc-design.md.
 #include "core/svrc/refiner.h"
 
+#include <bit>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -337,8 +338,14 @@ class Refiner {
       const int k = (kind == kOmegaCd3Linked && d == 0) ? kOmegaCd3Unlinked : kind;
       r->stats_.link_changes_by_kind[k] += d;
       ++r->stats_.insertions_by_kind[k];
+      r->event_kinds_ |= 1u << k;
+      ++r->event_insertions_;
     }
   };
+  // The kinds (bit per LinkChangeKind) and number of the insertions of the
+  // event being run (Run()'s per-kind time).
+  uint32_t event_kinds_ = 0;
+  uint32_t event_insertions_ = 0;
   absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd = kCdSegment);
 
   // --- Collars (stage (d): thesis §3.1.2, Figures 3.5, 3.7–3.9) ---------------
@@ -1405,6 +1412,7 @@ absl::Status Refiner::Run() {
   auto live = [this](const WorkEvent& e) { return IsLive(e); };
   uint64_t destroys = 0;
   while (true) {
+  auto tick = std::chrono::steady_clock::now();
   while (std::optional<WorkEvent> event = queues_.DequeueLive(live)) {
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached with ",
@@ -1412,8 +1420,28 @@ absl::Status Refiner::Run() {
     }
     if (absl::Status s = PollAt(destroys, event->radius); !s.ok()) return s;
     ++destroys;
+    event_kinds_ = 0;
+    event_insertions_ = 0;
     absl::Status s = Destroy(*event);
     if (!s.ok()) return s;
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - tick).count();
+    tick = now;
+    int kind = -1;
+    if (event_kinds_ & (1u << kSegmentMesh)) {
+      kind = kSegmentMesh;
+    } else if (event_kinds_ & (1u << kFacetMesh)) {
+      kind = kFacetMesh;
+    } else if (event_insertions_ == 1) {
+      kind = std::countr_zero(event_kinds_);
+    }
+    if (kind >= 0) {
+      stats_.seconds_by_kind[kind] += seconds;
+      ++stats_.events_by_kind[kind];
+    } else {
+      stats_.seconds_other_events += seconds;
+      ++stats_.other_events;
+    }
     if (options_.validate_every > 0 && destroys % options_.validate_every == 0) {
       s = CheckInvariants(false);
       if (!s.ok()) return s;
@@ -4160,6 +4188,10 @@ void Refiner::FillCounters(RefineStats* out) const {
   st.links_removed = blg_.stats().links_removed;
   st.link_changes_by_kind = stats_.link_changes_by_kind;
   st.insertions_by_kind = stats_.insertions_by_kind;
+  st.seconds_by_kind = stats_.seconds_by_kind;
+  st.events_by_kind = stats_.events_by_kind;
+  st.seconds_other_events = stats_.seconds_other_events;
+  st.other_events = stats_.other_events;
   st.clipped_cells = omega_.stats().clipped_queries;
   st.sizes_shrunk = omega_.stats().shrunk_sizes;
   st.size_queries = omega_.stats().size_queries;
@@ -4338,7 +4370,11 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   for (int k = 0; k < kNumLinkChangeKinds; ++k) {
     out->Set(absl::StrCat("svrc.link_changes.", kLinkChangeKindName[k]), static_cast<double>(link_changes_by_kind[k]));
     out->Set(absl::StrCat("svrc.insertions.", kLinkChangeKindName[k]), static_cast<double>(insertions_by_kind[k]));
+    out->Set(absl::StrCat("svrc.seconds.", kLinkChangeKindName[k]), seconds_by_kind[k]);
+    out->Set(absl::StrCat("svrc.events.", kLinkChangeKindName[k]), static_cast<double>(events_by_kind[k]));
   }
+  out->Set("svrc.seconds.other_events", seconds_other_events);
+  out->Set("svrc.other_events", static_cast<double>(other_events));
   out->Set("svrc.max_degree", max_degree);
   out->Set("svrc.max_aspect", max_aspect);
   out->Set("svrc.predicate_calls", static_cast<double>(predicate_calls));

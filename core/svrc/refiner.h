@@ -420,6 +420,18 @@ struct RefineStats {
   // bench/RESULTS.md "Session 28").
   std::array<uint64_t, kNumLinkChangeKinds> link_changes_by_kind{};
   std::array<uint64_t, kNumLinkChangeKinds> insertions_by_kind{};
+  // The refinement loop's wall time by the same kinds, per event: each
+  // event's time (finding it live in the queue, its Destroy, its insertions
+  // and every update that follows) goes to the lowest-dimensional mesh it
+  // inserted into (kSegmentMesh, else kFacetMesh: a feature point's event
+  // usually inserts it into its feature's mesh and then into M_Ω), else to
+  // its one M_Ω insertion's kind; events with none or several M_Ω
+  // insertions only are counted apart. Why the time per output tet falls as
+  // a mesh grows while each kind's time per event stays flat (session 42).
+  std::array<double, kNumLinkChangeKinds> seconds_by_kind{};
+  std::array<uint64_t, kNumLinkChangeKinds> events_by_kind{};
+  double seconds_other_events = 0;
+  uint64_t other_events = 0;
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_certified_partial = 0;  // ... of them next to the output's boundary (session 41)

@@ -725,6 +725,26 @@ TEST(CollarRefine, LinkChangesByKindAddUpToTheLinkCounters) {
     EXPECT_GE(changes, all - all / 50) << rel;
     std::printf("%s: %llu of %llu link changes made by insertions\n", rel, (unsigned long long)changes,
                 (unsigned long long)all);
+    // The refinement loop's time by kind (session 42): every live event is
+    // classified once, by the lowest-dimensional mesh it inserted into; a
+    // segment event inserts at least one segment point; the classified time
+    // is Run()'s time less its queue drains between rounds.
+    uint64_t live = 0, classified = st.other_events;
+    double seconds = st.seconds_other_events;
+    for (int t = 0; t < 4; ++t) live += st.events_popped[t] - st.events_stale[t];
+    for (int k = 0; k < kNumLinkChangeKinds; ++k) {
+      classified += st.events_by_kind[k];
+      seconds += st.seconds_by_kind[k];
+      EXPECT_GE(st.seconds_by_kind[k], 0.0) << rel;
+      EXPECT_EQ(st.events_by_kind[k] == 0, st.seconds_by_kind[k] == 0.0) << rel << " kind " << k;
+    }
+    EXPECT_EQ(classified, live) << rel;
+    EXPECT_GT(st.events_by_kind[kFacetMesh], 0u) << rel;
+    EXPECT_GT(st.events_by_kind[kSegmentMesh], 0u) << rel;
+    EXPECT_LE(st.events_by_kind[kSegmentMesh], st.segment_vertices) << rel;
+    EXPECT_GT(st.events_by_kind[kOmegaCd3Linked], 0u) << rel;
+    EXPECT_GT(seconds, 0.0) << rel;
+    EXPECT_LE(seconds, st.seconds * (1 + 1e-9)) << rel;
   }
 }
 
