@@ -202,6 +202,10 @@ class Refiner {
   // skinny: a Skinny event's gap ball (the kept corners, CellSize::kept_*);
   // else an Unresolved event's (the whole cell).
   absl::Status DestroyOmega(VertexId v, bool skinny);
+  // Whether Destroy of the CD-3 gap ball B(c, r) would warp: a pending 0-ball
+  // within θr of c (DestroyOmegaAt's test).
+  bool HasWarpTarget(const Vec3& c, double r);
+  std::vector<uint32_t> warp_probe_;
   // Figure 3.4 for the gap ball B(c, r) of M_Ω, c in the cell of v.
   absl::Status DestroyOmegaAt(const Vec3& c, double r, TetId hint, VertexId v, Cd cd_ball = kCdSpace);
  public:
@@ -1656,7 +1660,46 @@ absl::Status Refiner::DestroyOmega(VertexId v, bool skinny) {
   const CellSize s = (last_size_vertex_ == v && last_size_gen_ == omega_.CellGeneration(v)) ? last_size_
                                                                                            : omega_.Size(v);
   if (skinny) return DestroyOmegaAt(s.kept_corner, s.kept_outradius, s.kept_hint, v);
+  // Unresolved (RefineOptions::unresolved_kept_warp): both balls are empty
+  // circumballs of tets at v, gap balls of V(v); Destroy of either warps to
+  // a pending 0-ball within θ·r of its centre (lowest CD, nearest, lowest
+  // id). When the farthest corner's ball has none, Destroy would insert that
+  // corner, outside the output for a cell next to its boundary; when that
+  // corner is more than 16 times as far as the kept one (the cell's extent
+  // is its exterior part) and the kept corner's ball has a target, the point
+  // is resolved now. The factor, measured (session 42): without one,
+  // fan_6x60deg at radius_edge 1.414 went from 1,433 tets to 2,529 (an input
+  // whose count moves between 848 and 8,600 over bounds 1.40 to 1.5), with
+  // 2 to 1,645; from 4 on it meshes as before at every bound from 1.40 to
+  // 1.5. Below 16 the convex hull of CreaseMesh.MildCreasesLeavingBadTetsTake
+  // Collars meshes differently on its first, collar-free run (at 2 it ran
+  // into the vertex budget, 0.9 → 2.1 s; at 4 and 8 it met the bounds
+  // without collars). Cube 1e-6 keeps 83 of the 89 warps a factor of 4 makes.
+  constexpr double kExteriorExtent = 16;
+  if (options_.unresolved_kept_warp && !options_.collars && s.outside_tets && s.kept_outradius > 0 &&
+      s.outradius > kExteriorExtent * s.kept_outradius && !HasWarpTarget(s.corner, s.outradius) &&
+      HasWarpTarget(s.kept_corner, s.kept_outradius)) {
+    ++stats_.unresolved_kept_warps;
+    return DestroyOmegaAt(s.kept_corner, s.kept_outradius, s.kept_hint, v);
+  }
   return DestroyOmegaAt(s.corner, s.outradius, s.hint, v);
+}
+
+bool Refiner::HasWarpTarget(const Vec3& c, double r) {
+  // DestroyOmegaAt's warp test for a ball of CD 3: a 0-ball linked
+  // unresolved into M_Ω (the pending index holds exactly those), its point
+  // not in M_Ω nor suppressed, its centre within θr of c (the same doubles).
+  const double theta_r = options_.theta * r;
+  const double theta_r2 = theta_r * theta_r;
+  warp_probe_.clear();
+  pending_.Near(c, theta_r, &warp_probe_);
+  for (uint32_t id : warp_probe_) {
+    const BallId b(id);
+    const PointId p = balls_.VertexPoint(b);
+    if (points_.InMesh(p, kOmegaMesh) || Suppressed(p)) continue;
+    if (geom::Dist2(balls_.Center(b), c) <= theta_r2) return true;
+  }
+  return false;
 }
 
 absl::Status Refiner::DestroyOmegaAt(const Vec3& c_in, double r, TetId cell_hint, VertexId v, Cd cd_ball) {
@@ -4326,6 +4369,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.insertions", static_cast<double>(insertions));
   out->Set("svrc.sizes_certified", static_cast<double>(sizes_certified));
   out->Set("svrc.sizes_certified_partial", static_cast<double>(sizes_certified_partial));
+  out->Set("svrc.unresolved_kept_warps", static_cast<double>(unresolved_kept_warps));
   out->Set("svrc.sizes_uncertified", static_cast<double>(sizes_uncertified));
   out->Set("svrc.sizes_shrunk", static_cast<double>(sizes_shrunk));
   out->Set("svrc.size_queries", static_cast<double>(size_queries));

@@ -270,6 +270,17 @@ struct RefineOptions {
   // neighbour's bisector, not only the nearest vertex's (session 28; a
   // conservative superset either way; docs/svrc-design.md §8 item 57).
   bool tight_ball_cells = true;
+  // Without collars, an Unresolved event in a cell next to the output's
+  // boundary (star tets outside it and kept) whose gap ball ⟨farthest corner,
+  // R_v⟩ holds no warp target, with R_v more than 16 times the kept R_v,
+  // destroys the cell's largest kept gap ball ⟨kept corner, kept R_v⟩
+  // instead when that one holds one (within θ·its radius of its centre):
+  // the pending point is warped to at once instead of after insertions at
+  // the cell's exterior corners, whose cavities reach across M_Ω's coarse
+  // exterior (cube --max-volume 1e-5: 139 events of radius above 0.06, up
+  // to ~1,300 tets destroyed each, 12% of the refinement's time;
+  // docs/svrc-design.md §8 item 71). false: always the farthest corner.
+  bool unresolved_kept_warp = true;
   bool release_label_caches = true;
   // A tet's queued Skinny event is removed when the tet is destroyed, not
   // left in the queue until popped stale (session 29; the same refinement:
@@ -435,6 +446,7 @@ struct RefineStats {
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_certified_partial = 0;  // ... of them next to the output's boundary (session 41)
+  uint64_t unresolved_kept_warps = 0;    // Unresolved events destroyed at the kept corner (session 42)
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)
   uint64_t size_queries = 0;       // M_Ω Size() calls (and ShrunkSize answers)
