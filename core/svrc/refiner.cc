@@ -3,8 +3,8 @@
 // the thesis'. See refiner.h and docs/svrc-design.md.
 #include "core/svrc/refiner.h"
 
-#include <bit>
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -1677,8 +1677,8 @@ absl::Status Refiner::DestroyOmega(VertexId v, bool skinny) {
   // without collars). Cube 1e-6 keeps 83 of the 89 warps a factor of 4 makes.
   constexpr double kExteriorExtent = 16;
   if (options_.unresolved_kept_warp && !options_.collars && s.outside_tets && s.kept_outradius > 0 &&
-      s.outradius > kExteriorExtent * s.kept_outradius && !HasWarpTarget(s.corner, s.outradius) &&
-      HasWarpTarget(s.kept_corner, s.kept_outradius)) {
+      s.outradius > kExteriorExtent * s.kept_outradius && HasWarpTarget(s.kept_corner, s.kept_outradius) &&
+      !HasWarpTarget(s.corner, s.outradius)) {
     ++stats_.unresolved_kept_warps;
     return DestroyOmegaAt(s.kept_corner, s.kept_outradius, s.kept_hint, v);
   }
