@@ -543,6 +543,11 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
   // kind), each kind's share of the loop's time, and the spread of each
   // kind's µs per event over the runs: flat per kind while the mix moves is
   // the thesis' output-sensitive cost.
+  auto loop_seconds = [](const Row& r) {
+    double loop = r.r.D("sec_other_events");
+    for (const char* kn : refine::kLinkChangeKindName) loop += r.r.D(std::string("sec_") + kn);
+    return loop;
+  };
   std::printf("  - refinement loop µs per event by kind (share of the loop's time; events of no kind: share); spread over the runs:");
   for (int k = 0; k < refine::kNumLinkChangeKinds; ++k) {
     const std::string name = refine::kLinkChangeKindName[k];
@@ -550,8 +555,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
     double lo = HUGE_VAL, hi = 0;
     for (const Row& r : rows) {
       if (r.r.status != "OK") continue;
-      double loop = r.r.D("sec_other_events");
-      for (const char* kn : refine::kLinkChangeKindName) loop += r.r.D(std::string("sec_") + kn);
+      const double loop = loop_seconds(r);
       const double n = r.r.D("ev_" + name);
       const double us = n > 0 ? 1e6 * r.r.D("sec_" + name) / n : 0;
       if (n >= 100) {  // a kind with a handful of events says nothing about its cost
@@ -565,8 +569,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
   std::printf("; no kind");
   for (const Row& r : rows) {
     if (r.r.status != "OK") continue;
-    double loop = r.r.D("sec_other_events");
-    for (const char* kn : refine::kLinkChangeKindName) loop += r.r.D(std::string("sec_") + kn);
+    const double loop = loop_seconds(r);
     std::printf(" %s%%", F(loop > 0 ? 100 * r.r.D("sec_other_events") / loop : 0, 1).c_str());
   }
   std::printf("\n");

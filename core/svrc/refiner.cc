@@ -206,6 +206,10 @@ class Refiner {
   // within θr of c (DestroyOmegaAt's test).
   bool HasWarpTarget(const Vec3& c, double r);
   std::vector<uint32_t> warp_probe_;
+  // Vertex ball b is a warp target of a gap ball centred at c with
+  // (θr)² = theta_r2: its point is in neither M_Ω nor suppressed, and its
+  // centre lies within θr of c (*d2: the squared distance).
+  bool WarpTargetWithin(BallId b, const Vec3& c, double theta_r2, double* d2);
   // Figure 3.4 for the gap ball B(c, r) of M_Ω, c in the cell of v.
   absl::Status DestroyOmegaAt(const Vec3& c, double r, TetId hint, VertexId v, Cd cd_ball = kCdSpace);
  public:
@@ -350,6 +354,9 @@ class Refiner {
   // event being run (Run()'s per-kind time).
   uint32_t event_kinds_ = 0;
   uint32_t event_insertions_ = 0;
+  // RefineStats::seconds_by_kind: an event's time to the lowest-dimensional
+  // mesh it inserted into, else its one M_Ω insertion's kind, else "other".
+  void CountEventTime(double seconds);
   absl::Status ForceInsertSegment(uint32_t seg, uint32_t u, double t, Cd cd = kCdSegment);
 
   // --- Collars (stage (d): thesis §3.1.2, Figures 3.5, 3.7–3.9) ---------------
@@ -1410,6 +1417,24 @@ class AddSeconds {
   std::chrono::steady_clock::time_point start_;
 };
 
+void Refiner::CountEventTime(double seconds) {
+  int kind = -1;
+  if (event_kinds_ & (1u << kSegmentMesh)) {
+    kind = kSegmentMesh;
+  } else if (event_kinds_ & (1u << kFacetMesh)) {
+    kind = kFacetMesh;
+  } else if (event_insertions_ == 1) {
+    kind = std::countr_zero(event_kinds_);
+  }
+  if (kind >= 0) {
+    stats_.seconds_by_kind[kind] += seconds;
+    ++stats_.events_by_kind[kind];
+  } else {
+    stats_.seconds_other_events += seconds;
+    ++stats_.other_events;
+  }
+}
+
 absl::Status Refiner::Run() {
   const auto start = std::chrono::steady_clock::now();
   const geom::PredicateStats pred0 = geom::GetPredicateStats();
@@ -1429,23 +1454,8 @@ absl::Status Refiner::Run() {
     absl::Status s = Destroy(*event);
     if (!s.ok()) return s;
     const auto now = std::chrono::steady_clock::now();
-    const double seconds = std::chrono::duration<double>(now - tick).count();
+    CountEventTime(std::chrono::duration<double>(now - tick).count());
     tick = now;
-    int kind = -1;
-    if (event_kinds_ & (1u << kSegmentMesh)) {
-      kind = kSegmentMesh;
-    } else if (event_kinds_ & (1u << kFacetMesh)) {
-      kind = kFacetMesh;
-    } else if (event_insertions_ == 1) {
-      kind = std::countr_zero(event_kinds_);
-    }
-    if (kind >= 0) {
-      stats_.seconds_by_kind[kind] += seconds;
-      ++stats_.events_by_kind[kind];
-    } else {
-      stats_.seconds_other_events += seconds;
-      ++stats_.other_events;
-    }
     if (options_.validate_every > 0 && destroys % options_.validate_every == 0) {
       s = CheckInvariants(false);
       if (!s.ok()) return s;
@@ -1685,19 +1695,22 @@ absl::Status Refiner::DestroyOmega(VertexId v, bool skinny) {
   return DestroyOmegaAt(s.corner, s.outradius, s.hint, v);
 }
 
+bool Refiner::WarpTargetWithin(BallId b, const Vec3& c, double theta_r2, double* d2) {
+  const PointId p = balls_.VertexPoint(b);
+  if (points_.InMesh(p, kOmegaMesh) || Suppressed(p)) return false;
+  *d2 = geom::Dist2(balls_.Center(b), c);
+  return !(*d2 > theta_r2);
+}
+
 bool Refiner::HasWarpTarget(const Vec3& c, double r) {
-  // DestroyOmegaAt's warp test for a ball of CD 3: a 0-ball linked
-  // unresolved into M_Ω (the pending index holds exactly those), its point
-  // not in M_Ω nor suppressed, its centre within θr of c (the same doubles).
-  const double theta_r = options_.theta * r;
-  const double theta_r2 = theta_r * theta_r;
+  // DestroyOmegaAt's warp test for a ball of CD 3, over the pending index
+  // (the 0-balls linked unresolved into M_Ω, all of lower CD).
+  const double theta_r2 = (options_.theta * r) * (options_.theta * r);
   warp_probe_.clear();
-  pending_.Near(c, theta_r, &warp_probe_);
+  pending_.Near(c, options_.theta * r, &warp_probe_);
   for (uint32_t id : warp_probe_) {
-    const BallId b(id);
-    const PointId p = balls_.VertexPoint(b);
-    if (points_.InMesh(p, kOmegaMesh) || Suppressed(p)) continue;
-    if (geom::Dist2(balls_.Center(b), c) <= theta_r2) return true;
+    double d2;
+    if (balls_.CdOf(BallId(id)) < kCdSpace && WarpTargetWithin(BallId(id), c, theta_r2, &d2)) return true;
   }
   return false;
 }
@@ -1777,10 +1790,8 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c_in, double r, TetId cell_hint
     for (BallId b : gathered_) {
       if (!(balls_.CdOf(b) < cd_ball)) continue;
       if (balls_.IsVertexBall(b)) {
-        const PointId p = balls_.VertexPoint(b);
-        if (points_.InMesh(p, kOmegaMesh) || Suppressed(p)) continue;
-        const double d2 = geom::Dist2(balls_.Center(b), c);
-        if (d2 > theta_r2) continue;
+        double d2;
+        if (!WarpTargetWithin(b, c, theta_r2, &d2)) continue;
         // Line 6: lowest CD, then nearest to c, then lowest id (determinism).
         if (PreferWarp(b, d2, warp, warp_d2)) {
           warp = b;
