@@ -410,6 +410,39 @@ Delaunay2::VertexId Delaunay2::NearestVertex(Vec2 p, TriId hint) const {
   return VertexId(best);
 }
 
+Delaunay2::VertexId Delaunay2::NearVertex(Vec2 p, TriId hint) const {
+  TriId t = Locate(p, hint);
+  if (!t.valid()) t = TriId(last_tri_);
+  auto d2 = [&](uint32_t u) {
+    const double dx = points_[u].x - p.x, dy = points_[u].y - p.y;
+    return dx * dx + dy * dy;
+  };
+  uint32_t best = tri_v_[3 * t.value()];
+  double best_d2 = d2(best);
+  for (int i = 1; i < 3; ++i) {
+    const uint32_t u = tri_v_[3 * t.value() + i];
+    const double d = d2(u);
+    if (d < best_d2 || (d == best_d2 && u < best)) {
+      best = u;
+      best_d2 = d;
+    }
+  }
+  std::vector<VertexId>& nbrs = nbrs_scratch_;
+  for (bool moved = true; moved;) {
+    moved = false;
+    Neighbors(VertexId(best), &nbrs);
+    for (VertexId u : nbrs) {
+      const double d = d2(u.value());
+      if (d < best_d2) {  // strictly nearer: the descent ends
+        best = u.value();
+        best_d2 = d;
+        moved = true;
+      }
+    }
+  }
+  return VertexId(best);
+}
+
 absl::Status Delaunay2::Validate(bool check_empty_circle) const {
   const uint32_t nv = static_cast<uint32_t>(points_.size());
   uint32_t live = 0, boundary_edges = 0;

@@ -142,6 +142,13 @@ class Delaunay2 {
   // Nearest vertex to p (ties: smallest vertex id); walk + greedy descent on
   // the Delaunay graph (exact distance comparisons). p must be inside.
   VertexId NearestVertex(Vec2 p, TriId hint = kNoneTri) const;
+  // A vertex nearest to p up to rounding: the same walk and descent on
+  // squared distances in doubles, moving only to a strictly nearer vertex.
+  // For seeding searches that need a cell meeting a disk around p, not the
+  // exact nearest: from a circumcentre, the three corners tie and
+  // NearestVertex settles them with exact arithmetic (~700 instructions per
+  // comparison, svrc's facet Destroy).
+  VertexId NearVertex(Vec2 p, TriId hint = kNoneTri) const;
 
   // --- triangle constructions --------------------------------------------
   Vec2 Circumcenter(TriId t) const;

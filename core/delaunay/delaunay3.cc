@@ -868,6 +868,34 @@ VertexId Delaunay3::NearestVertex(const Vec3& p, TetId hint) const {
   }
 }
 
+VertexId Delaunay3::NearVertex(const Vec3& p, TetId hint) const {
+  if (!Is3d()) return kNoneVertex;
+  const uint32_t t = Locate(p, hint).value();
+  uint32_t best = kFreeSlot;
+  double best_d2 = 0;
+  for (int i = 0; i < 4; ++i) {
+    const uint32_t w = tets_[8 * t + i];
+    if (w == kInf) continue;
+    const double d = geom::Dist2(p, points_[w]);
+    if (best == kFreeSlot || d < best_d2 || (d == best_d2 && w < best)) {
+      best = w;
+      best_d2 = d;
+    }
+  }
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (VertexId w : NeighborsView(VertexId(best))) {  // the list of the vertex the pass began at
+      const double d = geom::Dist2(p, points_[w.value()]);
+      if (d < best_d2) {  // strictly nearer: the descent ends
+        best = w.value();
+        best_d2 = d;
+        moved = true;
+      }
+    }
+  }
+  return VertexId(best);
+}
+
 VertexId Delaunay3::VertexAt(const Vec3& p, TetId hint) const {
   if (!Is3d()) return kNoneVertex;
   // Locate returns a finite tet whose closure holds p, or the ghost whose

@@ -227,6 +227,9 @@ class Delaunay3 {
   // The vertex nearest to p (ties: smallest vertex id): walk + greedy descent
   // on the Delaunay graph. kNoneVertex while !Is3d().
   VertexId NearestVertex(const Vec3& p, TetId hint = kNoneTet) const;
+  // A vertex nearest to p up to rounding (Delaunay2::NearVertex): for seeding
+  // searches that need a cell meeting a ball around p, not the exact nearest.
+  VertexId NearVertex(const Vec3& p, TetId hint = kNoneTet) const;
   // The vertex whose point is exactly p, or kNoneVertex (also while
   // !Is3d()): one Locate and coordinate comparisons, no distance predicate.
   // A vertex at p is a vertex of every tet whose closure contains p, so this

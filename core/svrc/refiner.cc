@@ -1227,7 +1227,7 @@ void Refiner::LinkPieceToFacet(BallId b, uint32_t f, TriId2 hint) {
   const Vec2 a = Uv(f, balls_.Vertex(b, 0)), c = Uv(f, balls_.Vertex(b, 1));
   const Vec2 mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
   const double r = 0.5 * std::sqrt((a.x - c.x) * (a.x - c.x) + (a.y - c.y) * (a.y - c.y));
-  const VertexId2 w = dt.NearestVertex(mid, hint);
+  const VertexId2 w = options_.collars ? dt.NearestVertex(mid, hint) : dt.NearVertex(mid, hint);
   std::vector<VertexId2> cells;
   CellsMeetingDisk(f, mid, r, w, &cells);
   for (VertexId2 x : cells) AddFacetPieceLink(f, x, b);
@@ -1276,7 +1276,9 @@ void Refiner::AddBallLink(VertexId x, BallId b) {
 
 void Refiner::LinkBallToOmega(BallId b, VertexId start) {
   const delaunay::Delaunay3& dt = omega_.dt();
-  const VertexId w = dt.NearestVertex(balls_.Center(b), dt.VertexTet(start));
+  // The seed, as DestroyFacet's: a cell meeting the ball (it is always kept).
+  const VertexId w = options_.collars ? dt.NearestVertex(balls_.Center(b), dt.VertexTet(start))
+                                      : dt.NearVertex(balls_.Center(b), dt.VertexTet(start));
   std::vector<VertexId>& cells = link_cells_;
   CellsMeetingBall(balls_.Center(b), balls_.Radius(b), w, &cells);
   for (VertexId x : cells) AddBallLink(x, b);
@@ -1570,7 +1572,11 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached", BudgetHint()));
     }
-    const VertexId2 w = m.dt().NearestVertex(c, hint);
+    // Without collars the seed only needs a cell meeting the disk (nearest
+    // to c up to rounding, NearVertex): the search keeps the cells that pass
+    // its test and Destroy's choices are total orders over their balls.
+    // With collars the event order follows the links' order (§8 item 37).
+    const VertexId2 w = options_.collars ? m.dt().NearestVertex(c, hint) : m.dt().NearVertex(c, hint);
     CellsMeetingDisk(f, c, r, w, &bfs2_);
     stats_.destroy_cells_visited += bfs2_.size();
     BallId warp, yield;

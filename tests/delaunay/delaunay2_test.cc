@@ -290,5 +290,49 @@ TEST(Delaunay2Test, InsertFromConflictingHint) {
   EXPECT_TRUE(d.Validate().ok()) << d.Validate();
 }
 
+// NearVertex (2D): the exact nearest on random queries; from circumcentres
+// (three tied corners) and on an integer grid, no farther than the nearest
+// by more than rounding.
+TEST(Delaunay2Test, NearVertexIsNearestUpToRounding) {
+  for (const bool grid : {false, true}) {
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Delaunay2 d = Box(-1, 11);
+    std::vector<Vec2> pts;
+    std::vector<uint32_t> ids;
+    for (int i = 0; i < 400; ++i) {
+      pts.push_back(grid ? Vec2{double(i % 20) / 2, double(i / 20) / 2} : Vec2{10 * u(rng), 10 * u(rng)});
+      ids.push_back(100 + i);
+    }
+    InsertAllChecked(d, pts, ids);
+    auto min_d2 = [&](Vec2 q) {
+      double m = HUGE_VAL;
+      for (uint32_t v = 0; v < d.NumVertices(); ++v) {
+        const Vec2 p = d.Point(VertexId(v));
+        m = std::min(m, (p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y));
+      }
+      return m;
+    };
+    std::vector<Vec2> queries;
+    for (int q = 0; q < 300; ++q) queries.push_back({10 * u(rng), 10 * u(rng)});
+    if (!grid) {
+      for (Vec2 q : queries) EXPECT_EQ(d.NearVertex(q), d.NearestVertex(q));
+    }
+    const std::vector<TriId> tris = d.Triangles();
+    for (TriId t : tris) {
+      const Vec2 c = d.Circumcenter(t);
+      if (c.x > -1 && c.x < 11 && c.y > -1 && c.y < 11) queries.push_back(c);
+    }
+    size_t k = 0;
+    for (Vec2 q : queries) {
+      const VertexId v = d.NearVertex(q, tris[k++ % tris.size()]);
+      ASSERT_TRUE(v.valid());
+      const Vec2 p = d.Point(v);
+      const double m = min_d2(q);
+      EXPECT_LE((p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y), m + 1e-12 * (1 + m));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace svrc::delaunay

@@ -562,5 +562,41 @@ TEST(SpatialSortTest, HilbertIsAPermutationAndAdjacentCellsAreAdjacent) {
   EXPECT_EQ(o, Iota(1000));
 }
 
+// NearVertex: a vertex nearest to the query up to rounding (double squared
+// distances): the exact nearest on random queries, and from a circumcentre,
+// where the corners tie, a vertex no farther than the nearest by more than
+// rounding; on an integer grid (exact ties everywhere) likewise. With and
+// without the neighbour cache.
+TEST(Delaunay3Test, NearVertexIsNearestUpToRounding) {
+  for (const bool cache : {false, true}) {
+    for (const bool grid : {false, true}) {
+      const std::vector<Vec3> pts = grid ? Grid(6) : RandomPoints(600, 21);
+      Delaunay3 dt = BuildValidated(pts, Shuffled(pts.size(), 5), /*every_step=*/false);
+      dt.set_cache_neighbors(cache);
+      auto min_d2 = [&](const Vec3& q) {
+        double m = HUGE_VAL;
+        for (const Vec3& p : pts) m = std::min(m, geom::Dist2(q, p));
+        return m;
+      };
+      std::vector<Vec3> queries = RandomPoints(300, 23);
+      if (grid) {
+        for (Vec3& q : queries) q = q * 5.0;
+      } else {
+        for (const Vec3& q : queries) EXPECT_EQ(dt.NearVertex(q), dt.NearestVertex(q)) << q.x << " " << q.y << " " << q.z;
+      }
+      int k = 0;
+      for (TetId t : dt.FiniteTets()) {
+        if (k++ % 3 == 0) queries.push_back(dt.Circumcenter(t));
+      }
+      for (const Vec3& q : queries) {
+        const VertexId v = dt.NearVertex(q, dt.FiniteTets()[k++ % dt.NumFiniteTets()]);
+        ASSERT_TRUE(v.valid());
+        const double m = min_d2(q);
+        EXPECT_LE(geom::Dist2(q, dt.Point(v)), m + 1e-12 * (1 + m)) << q.x << " " << q.y << " " << q.z;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace svrc::delaunay
