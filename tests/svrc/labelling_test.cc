@@ -439,5 +439,57 @@ TEST(LabellingTest, Errors) {
   EXPECT_EQ(LabelRegions(in).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
+// Seeds are located by a walk through the tets (the scan takes the points it
+// cannot settle: on a face, edge or vertex, or outside): on a Kuhn grid with
+// its tets in a scrambled order (tet 0 anywhere), every seed's tet is the one
+// the tie rule gives by brute force — the tet strictly containing it, else
+// the lexicographically smallest sorted vertex ids among those whose closure
+// holds it; a seed outside the grid has none.
+TEST(LabellingTest, WalkedSeedsGetTheTieRulesTet) {
+  testing::Grid g = testing::KuhnGrid(6);
+  std::mt19937 rng(31);
+  std::shuffle(g.tets.begin(), g.tets.end(), rng);
+  std::uniform_real_distribution<double> u(-0.5, 6.5);
+  std::vector<plc::RegionSeed> seeds;
+  for (int i = 0; i < 200; ++i) seeds.push_back({{u(rng), u(rng), u(rng)}, static_cast<double>(i), 0});
+  for (int i = 0; i < 40; ++i) {  // on grid faces, edges and vertices
+    const double x = std::floor(u(rng)), y = std::floor(u(rng)) + 0.5 * (i % 2), z = u(rng);
+    seeds.push_back({{std::clamp(x, 0.0, 6.0), std::clamp(y, 0.0, 6.0), i % 3 == 0 ? std::round(z) : z}, static_cast<double>(200 + i), 0});
+  }
+  LabelInput in;
+  in.positions = g.positions;
+  in.tets = g.tets;
+  in.region_seeds = seeds;
+  in.keep_bounding_box = true;
+  auto l = LabelRegions(in);
+  ASSERT_TRUE(l.ok()) << l.status();
+  ASSERT_EQ(l->seed_tet.size(), seeds.size());
+  int strict = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    const Vec3 q = seeds[i].point;
+    uint32_t want = kNoTet;
+    bool want_strict = false;
+    std::array<uint32_t, 4> want_key{};
+    for (uint32_t t = 0; t < g.tets.size(); ++t) {
+      const auto& v = g.tets[t];
+      const Vec3 a = g.positions[v[0]], b = g.positions[v[1]], c = g.positions[v[2]], d = g.positions[v[3]];
+      const int s[4] = {geom::Orient3d(q, b, c, d), geom::Orient3d(a, q, c, d), geom::Orient3d(a, b, q, d),
+                        geom::Orient3d(a, b, c, q)};
+      if (s[0] < 0 || s[1] < 0 || s[2] < 0 || s[3] < 0) continue;
+      const bool st = s[0] > 0 && s[1] > 0 && s[2] > 0 && s[3] > 0;
+      std::array<uint32_t, 4> key = v;
+      std::sort(key.begin(), key.end());
+      if (want == kNoTet || (st && !want_strict) || (st == want_strict && key < want_key)) {
+        want = t;
+        want_strict = st;
+        want_key = key;
+      }
+    }
+    strict += want_strict;
+    EXPECT_EQ(l->seed_tet[i], want) << "seed " << i << " (" << q.x << ", " << q.y << ", " << q.z << ")";
+  }
+  EXPECT_GT(strict, 100);  // most seeds were walked to
+}
+
 }  // namespace
 }  // namespace svrc::refine
