@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "core/geometry/predicates.h"
@@ -95,6 +96,15 @@ FacetRegion::Where FacetRegion::Locate(Vec2 p) const {
 }
 
 bool TriangleMeetsSegment(Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
+  // Disjoint bounding boxes: the closed triangle and segment are disjoint,
+  // and then a line through an edge of one of them separates them (convex
+  // polygons), so the tests below return false too. Without predicates:
+  // on cube --max-volume 1e-4 most triangles outside F are far from most of
+  // its segments.
+  if (std::max({a.x, b.x, c.x}) < std::min(s0.x, s1.x) || std::min({a.x, b.x, c.x}) > std::max(s0.x, s1.x) ||
+      std::max({a.y, b.y, c.y}) < std::min(s0.y, s1.y) || std::min({a.y, b.y, c.y}) > std::max(s0.y, s1.y)) {
+    return false;
+  }
   const std::array<Vec2, 3> t = {a, b, c};
   // Triangle edge lines (abc counter-clockwise: interior is left, > 0).
   for (int e = 0; e < 3; ++e) {
@@ -327,8 +337,18 @@ void FacetMesh::CreateAllTriangleBalls(const plc::FacetFrame& frame, FeatureId f
 CellSize2 FacetMesh::Size(VertexId2 v) const {
   CellSize2 out;
   const Vec2 pv = dt_.Point(v);
-  out.inradius = dt_.InRadius(v);
   dt_.Star(v, &star_);
+  // r_v = Delaunay2::InRadius(v), from the star's vertices (v's neighbours,
+  // each seen once or twice) instead of a second walk around v: the same
+  // minimum of the same squared distances.
+  double shortest2 = std::numeric_limits<double>::infinity();
+  for (TriId2 t : star_) {
+    for (int i = 0; i < 3; ++i) {
+      const VertexId2 u = dt_.TriVertex(t, i);
+      if (u != v) shortest2 = std::min(shortest2, geom::Norm2(dt_.Point(u) - pv));
+    }
+  }
+  out.inradius = 0.5 * std::sqrt(shortest2);
   poly_.clear();
   bool outside = dt_.IsCorner(v);  // a corner's cell is unbounded
   if (!outside) {

@@ -2,6 +2,7 @@
 // "triangle in F" (guide §5 item 4), Delaunay validity of M_F inside Ω_F, and
 // clipped cell sizes. The in-facet triangles must cover F exactly (area) when
 // F's segments are edges of M_F, and cover it (area ≥) in any case.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
@@ -202,6 +203,7 @@ bool CheckFacetMesh(const FacetRegion& region, uint32_t corner_base, double face
   for (uint32_t v = 0; v < dt.NumVertices(); ++v) {
     const auto vid = delaunay::Delaunay2::VertexId(v);
     const CellSize2 s = mesh.Size(vid);
+    EXPECT_EQ(s.inradius, dt.InRadius(vid));  // from the star: the same double
     EXPECT_TRUE(std::isfinite(s.outradius));
     if (dt.IsCorner(vid) && s.outradius == 0) {
       // A quadrilateral corner whose cell no longer meets Ω_F.
@@ -336,6 +338,52 @@ TEST(FacetMeshTest, CorpusExampleWithHole) {
   const int n = CheckCorpusFacets("b_internal/example.poly");
   EXPECT_GE(n, 0);
   ::testing::Test::RecordProperty("conforming_facets", n);
+}
+
+// TriangleMeetsSegment rejects disjoint bounding boxes before its predicates;
+// the answer is the separating-axis test's on every pair: small integer
+// coordinates (segments touching vertices and edges, collinear with edges,
+// boxes sharing a side) and random ones, against the predicates alone.
+TEST(FacetRegionTest, TriangleMeetsSegmentBoxRejectKeepsTheAnswer) {
+  auto reference = [](Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
+    const std::array<Vec2, 3> t = {a, b, c};
+    for (int e = 0; e < 3; ++e) {
+      if (geom::Orient2d(t[e], t[(e + 1) % 3], s0) <= 0 && geom::Orient2d(t[e], t[(e + 1) % 3], s1) <= 0) return false;
+    }
+    int pos = 0, neg = 0;
+    for (const Vec2& x : t) {
+      const int o = geom::Orient2d(s0, s1, x);
+      pos += o > 0;
+      neg += o < 0;
+    }
+    return pos != 0 && neg != 0;
+  };
+  uint64_t z = 12345;
+  auto next = [&](int k) {
+    z = z * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<int>((z >> 33) % static_cast<uint64_t>(k));
+  };
+  int met = 0, rejected_by_box = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const bool small = i % 2 == 0;
+    auto pt = [&]() {
+      return small ? Vec2{double(next(5)), double(next(5))}
+                   : Vec2{next(1 << 20) / double(1 << 18), next(1 << 20) / double(1 << 18)};
+    };
+    Vec2 a = pt(), b = pt(), c = pt();
+    const int o = geom::Orient2d(a, b, c);
+    if (o == 0) continue;
+    if (o < 0) std::swap(b, c);
+    const Vec2 s0 = pt(), s1 = pt();
+    const bool want = reference(a, b, c, s0, s1);
+    ASSERT_EQ(TriangleMeetsSegment(a, b, c, s0, s1), want)
+        << a.x << "," << a.y << " " << b.x << "," << b.y << " " << c.x << "," << c.y << " | " << s0.x << "," << s0.y
+        << " " << s1.x << "," << s1.y;
+    met += want;
+    rejected_by_box += std::max({a.x, b.x, c.x}) < std::min(s0.x, s1.x) || std::min({a.y, b.y, c.y}) > std::max(s0.y, s1.y);
+  }
+  EXPECT_GT(met, 10000);
+  EXPECT_GT(rejected_by_box, 10000);
 }
 
 }  // namespace
