@@ -341,6 +341,7 @@ CellSize OmegaMesh::ComputeSize(VertexId v, Uniqueness* unique) const {
     }
   }
   const bool kept_from_star = out.outside_tets && kept_plain;
+  out.kept_from_star = kept_from_star;
   // Clip every Voronoi facet of v (dual to edge vu) to the cube.
   *unique = Uniqueness{};
   ++stats_.clipped_queries;

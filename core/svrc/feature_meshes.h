@@ -41,6 +41,9 @@ struct CellSize {
   geom::Vec3 kept_corner;
   TetId kept_hint;
   bool outside_tets = false;  // a star tet is known to lie outside the output
+  // Clipped cells only: the kept_* fields came from the star's kept tets,
+  // every one of them plain (not a ghost or flat, circumcentre inside Ω).
+  bool kept_from_star = false;
 };
 
 // Per M_Ω tet slot: its label class (the region's size target and volume
@@ -166,10 +169,14 @@ class OmegaMesh {
     double kept_corner = 0;
     bool outside = false;
     bool all_outside = true;
+    // The largest d of the plain new tets (corners of V(v) ∩ Ω, so ≤ R_v
+    // also when the cell is clipped).
+    double plain_corner = 0;
     // One new tet at v: d = |cc − v|, or +inf when it is not plain.
     void Add(double d, bool tet_outside) {
       ++count;
       corner = std::max(corner, d);
+      if (d != HUGE_VAL) plain_corner = std::max(plain_corner, d);
       if (!tet_outside) kept_corner = std::max(kept_corner, d);
       outside = outside || tet_outside;
       all_outside = all_outside && tet_outside;

@@ -446,6 +446,7 @@ struct RefineStats {
   uint64_t clipped_cells = 0;      // cell-size queries that clipped to Ω
   uint64_t sizes_certified = 0;    // cavity cells kept good without a star walk
   uint64_t sizes_certified_partial = 0;  // ... of them next to the output's boundary (session 41)
+  uint64_t sizes_certified_clipped = 0;  // ... of those clipped to Ω (session 43)
   uint64_t unresolved_kept_warps = 0;    // Unresolved events destroyed at the kept corner (session 42)
   uint64_t sizes_uncertified = 0;  // ... of which a link needed the exact R_v after all
   uint64_t sizes_shrunk = 0;       // cavity cells sized from their memo (OmegaMesh::ShrunkSize)

@@ -393,7 +393,8 @@ std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase
 // these inputs no such cell's bound ever exceeded τ·r_v or a size target
 // (checked against Size() in session 41), so the test shows the same
 // refinement and that the path is taken, not that each of its conditions
-// is needed; docs/svrc-design.md §8 item 70 argues them.
+// is needed; docs/svrc-design.md §8 item 70 argues them. Since session 43
+// the same holds for such cells clipped to Ω (CellCert::clipped; item 73).
 TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
   if (kSanitized) GTEST_SKIP() << "release only";
   for (const SameRefinementCase& c :
@@ -409,7 +410,11 @@ TEST(CollarRefine, CertifiedCellsGiveTheSameRefinement) {
     EXPECT_EQ(runs[0].stats.sizes_certified_partial, 0u) << c.rel;
     if (c.max_volume > 0) {
       EXPECT_GT(runs[1].stats.sizes_certified_partial, c.cell_test ? 300u : 1000u) << c.rel << (c.cell_test ? " (cell test)" : "");
+      if (!c.cell_test) {
+        EXPECT_GT(runs[1].stats.sizes_certified_clipped, 300u) << c.rel;
+      }
     }
+    EXPECT_EQ(runs[0].stats.sizes_certified_clipped, 0u) << c.rel;
   }
 }
 
