@@ -45,6 +45,7 @@ struct CellSize {
   // every one of them plain (not a ghost or flat, circumcentre inside Ω).
   bool kept_from_star = false;
 };
+static_assert(sizeof(CellSize) == 88);  // the size memo's records (kept_from_star fills padding)
 
 // Per M_Ω tet slot: its label class (the region's size target and volume
 // bound, in the refiner's table of classes: one per distinct pair, so a run

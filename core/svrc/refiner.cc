@@ -874,13 +874,15 @@ class Refiner {
     // |cc − u| ≤ kept (≥ the kept corner's distance), ≤ τ·r_u and ≤ u's size
     // target.
     bool partial = false;
-    double kept = 0;
     // `partial` for a cell clipped to Ω (its kept tets all plain): it stays
     // certified only while a new tet keeps it next to the outside (then
     // Size() reads its kept corner from the kept tets as before; with none
-    // outside it would read the clipped cell's).
+    // outside it would read the clipped cell's). Beside the other flags: 32
+    // bytes per vertex, as before it.
     bool clipped = false;
+    double kept = 0;
   };
+  static_assert(sizeof(CellCert) == 32);
   util::PodVector<CellCert> cell_cert_;
   std::vector<TetId> created_;
   std::vector<OmegaMesh::NewTets> new_at_;  // per cell of 𝒱: what the insertion added to its star
@@ -1956,8 +1958,8 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
                              plain && !sizes[i].outside_tets,
                              sizes[i].outside_tets && sizes[i].kept_outradius == 0,
                              good && kept_plain && sizes[i].outside_tets && sizes[i].kept_outradius > 0,
-                             sizes[i].kept_outradius,
-                             sizes[i].clipped};
+                             sizes[i].clipped,
+                             sizes[i].kept_outradius};
   };
   auto exact_size = [&](size_t i) {
     sizes[i] = omega_.Size(changed[i]);
