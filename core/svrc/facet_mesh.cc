@@ -95,16 +95,8 @@ FacetRegion::Where FacetRegion::Locate(Vec2 p) const {
   return Where::kInside;
 }
 
-bool TriangleMeetsSegment(Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
-  // Disjoint bounding boxes: the closed triangle and segment are disjoint,
-  // and then a line through an edge of one of them separates them (convex
-  // polygons), so the tests below return false too. Without predicates:
-  // on cube --max-volume 1e-4 most triangles outside F are far from most of
-  // its segments.
-  if (std::max({a.x, b.x, c.x}) < std::min(s0.x, s1.x) || std::min({a.x, b.x, c.x}) > std::max(s0.x, s1.x) ||
-      std::max({a.y, b.y, c.y}) < std::min(s0.y, s1.y) || std::min({a.y, b.y, c.y}) > std::max(s0.y, s1.y)) {
-    return false;
-  }
+namespace internal {
+bool TriangleMeetsSegmentBySides(Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
   const std::array<Vec2, 3> t = {a, b, c};
   // Triangle edge lines (abc counter-clockwise: interior is left, > 0).
   for (int e = 0; e < 3; ++e) {
@@ -120,6 +112,20 @@ bool TriangleMeetsSegment(Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
     neg += o < 0;
   }
   return pos != 0 && neg != 0;
+}
+}  // namespace internal
+
+bool TriangleMeetsSegment(Vec2 a, Vec2 b, Vec2 c, Vec2 s0, Vec2 s1) {
+  // Disjoint bounding boxes: the closed triangle and segment are disjoint,
+  // and then a line through an edge of one of them separates them (convex
+  // polygons), so the side tests return false too. Without predicates: on
+  // cube --max-volume 1e-4 most triangles outside F are far from most of its
+  // segments.
+  if (std::max({a.x, b.x, c.x}) < std::min(s0.x, s1.x) || std::min({a.x, b.x, c.x}) > std::max(s0.x, s1.x) ||
+      std::max({a.y, b.y, c.y}) < std::min(s0.y, s1.y) || std::min({a.y, b.y, c.y}) > std::max(s0.y, s1.y)) {
+    return false;
+  }
+  return internal::TriangleMeetsSegmentBySides(a, b, c, s0, s1);
 }
 
 bool FacetRegion::CrossesSegment(Vec2 a, Vec2 b, Vec2 c) const {

@@ -72,6 +72,11 @@ struct FacetRegion {
 // abc (exact: one of the triangle's edge lines or the segment's line
 // separates them, the separating-axis theorem in 2D).
 bool TriangleMeetsSegment(geom::Vec2 a, geom::Vec2 b, geom::Vec2 c, geom::Vec2 s0, geom::Vec2 s1);
+namespace internal {
+// The same by the side tests alone, without TriangleMeetsSegment's bounding-box
+// reject (for the test that the reject never changes the answer).
+bool TriangleMeetsSegmentBySides(geom::Vec2 a, geom::Vec2 b, geom::Vec2 c, geom::Vec2 s0, geom::Vec2 s1);
+}  // namespace internal
 
 // Builds F's region in the *normalised* frame: the frame's origin goes through
 // the same exact map as the points (its u, v are unchanged: the map is a
