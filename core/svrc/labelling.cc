@@ -98,14 +98,13 @@ std::vector<std::vector<Hit>> LocatePoints(std::span<const Vec3> pos,
   // Walk first (region seeds lie inside their regions; on cube --max-volume
   // 1e-5 the scan below was 4% of the run's instructions); the scan takes
   // the points no walk settles.
-  std::vector<uint8_t> walked(queries.size(), 0);
+  // A walked point has its one hit; the scan takes those with none.
   const size_t max_steps = 64 + 16 * static_cast<size_t>(std::cbrt(static_cast<double>(tets.size())));
   size_t left = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
     const uint32_t t = geom::IsFinite(queries[i]) ? WalkToStrictTet(pos, tets, nbr4, queries[i], max_steps) : kNoTet;
     if (t != kNoTet) {
       hits[i].push_back({t, true});
-      walked[i] = 1;
     } else {
       ++left;
     }
@@ -133,7 +132,7 @@ std::vector<std::vector<Hit>> LocatePoints(std::span<const Vec3> pos,
   std::vector<size_t> qcell(queries.size(), num_cells);
   for (size_t i = 0; i < queries.size(); ++i) {
     const Vec3& q = queries[i];
-    if (walked[i] || !geom::IsFinite(q) || !inside_box(q)) continue;
+    if (!hits[i].empty() || !geom::IsFinite(q) || !inside_box(q)) continue;
     qcell[i] = (static_cast<size_t>(cell1(q.z, lo.z, hi.z)) * n + cell1(q.y, lo.y, hi.y)) * n +
                cell1(q.x, lo.x, hi.x);
     ++start[qcell[i] + 1];

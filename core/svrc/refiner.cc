@@ -557,6 +557,19 @@ class Refiner {
   // PropagateLocation of a ball of radius > 0 into M_Ω: link every cell that
   // may meet it, starting near `start`.
   void LinkBallToOmega(BallId b, VertexId start);
+  // The seed of a search for the cells meeting a ball or disk centred at c
+  // (CellsMeetingBall, CellsMeetingDisk): without collars a vertex nearest
+  // up to rounding (NearVertex, §8 item 72) — its cell meets the ball, the
+  // search keeps the cells that pass its test, and Destroy's choices are
+  // total orders over their balls; with collars the exact nearest, since the
+  // event order follows the links' order there (§8 item 37).
+  VertexId SeedVertex(const Vec3& c, TetId hint) const {
+    const delaunay::Delaunay3& dt = omega_.dt();
+    return options_.collars ? dt.NearestVertex(c, hint) : dt.NearVertex(c, hint);
+  }
+  VertexId2 SeedVertex(const delaunay::Delaunay2& dt, Vec2 c, TriId2 hint) const {
+    return options_.collars ? dt.NearestVertex(c, hint) : dt.NearVertex(c, hint);
+  }
   // PropagateLocation of a 0-ball into M_Ω: link the cell containing its
   // point (an unresolved object), refresh that cell's events.
   void LinkVertexBallToOmega(BallId b, VertexId start);
@@ -1234,7 +1247,7 @@ void Refiner::LinkPieceToFacet(BallId b, uint32_t f, TriId2 hint) {
   const Vec2 a = Uv(f, balls_.Vertex(b, 0)), c = Uv(f, balls_.Vertex(b, 1));
   const Vec2 mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
   const double r = 0.5 * std::sqrt((a.x - c.x) * (a.x - c.x) + (a.y - c.y) * (a.y - c.y));
-  const VertexId2 w = options_.collars ? dt.NearestVertex(mid, hint) : dt.NearVertex(mid, hint);
+  const VertexId2 w = SeedVertex(dt, mid, hint);
   std::vector<VertexId2> cells;
   CellsMeetingDisk(f, mid, r, w, &cells);
   for (VertexId2 x : cells) AddFacetPieceLink(f, x, b);
@@ -1283,9 +1296,7 @@ void Refiner::AddBallLink(VertexId x, BallId b) {
 
 void Refiner::LinkBallToOmega(BallId b, VertexId start) {
   const delaunay::Delaunay3& dt = omega_.dt();
-  // The seed, as DestroyFacet's: a cell meeting the ball (it is always kept).
-  const VertexId w = options_.collars ? dt.NearestVertex(balls_.Center(b), dt.VertexTet(start))
-                                      : dt.NearVertex(balls_.Center(b), dt.VertexTet(start));
+  const VertexId w = SeedVertex(balls_.Center(b), dt.VertexTet(start));
   std::vector<VertexId>& cells = link_cells_;
   CellsMeetingBall(balls_.Center(b), balls_.Radius(b), w, &cells);
   for (VertexId x : cells) AddBallLink(x, b);
@@ -1579,11 +1590,7 @@ absl::Status Refiner::DestroyFacet(uint32_t f, Vec2 c, double r, TriId2 hint, Tr
     if (TotalVertices() >= budget_) {
       return absl::ResourceExhaustedError(absl::StrCat("SVRC: vertex budget of ", budget_, " reached", BudgetHint()));
     }
-    // Without collars the seed only needs a cell meeting the disk (nearest
-    // to c up to rounding, NearVertex): the search keeps the cells that pass
-    // its test and Destroy's choices are total orders over their balls.
-    // With collars the event order follows the links' order (§8 item 37).
-    const VertexId2 w = options_.collars ? m.dt().NearestVertex(c, hint) : m.dt().NearVertex(c, hint);
+    const VertexId2 w = SeedVertex(m.dt(), c, hint);
     CellsMeetingDisk(f, c, r, w, &bfs2_);
     stats_.destroy_cells_visited += bfs2_.size();
     BallId warp, yield;
