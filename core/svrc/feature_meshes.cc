@@ -63,15 +63,18 @@ bool OmegaMesh::InsideCube(const Vec3& p) const {
 }
 
 namespace {
-// The table size for `n` keys: a power of two >= n, at most `limit` (0: no
-// limit).
+// The table size for `n` keys: the power of two <= n (at least 64), at most
+// `limit` (0: no limit). Between a half and one record per key, as the large
+// runs' capped tables have: rounding up gave the small runs up to two per key
+// (cube 1e-4: a 1 MiB circumcentre table for 22k tets, 16% of the heap's
+// peak; session 44, bench/RESULTS.md).
 size_t CacheSize(size_t n, uint32_t limit) {
-  const size_t want = std::bit_ceil(std::max<size_t>(n, 64));
+  const size_t want = std::bit_floor(std::max<size_t>(n, 64));
   return limit == 0 ? want : std::min<size_t>(want, limit);
 }
 
 // Grows a direct-mapped table to CacheSize(n, limit) records when `key` (the
-// index looked up) lies beyond it and the limit allows; the records move to
+// index looked up) lies beyond it and that size is larger; the records move to
 // their new places (a record's place is its key's low bits; the new places
 // of the old records are distinct, each its old place or one beyond the old
 // table). key_of(record) is its key, or `none` for an empty record.
@@ -80,6 +83,7 @@ void GrowTable(util::PodVector<R>& table, uint32_t key, size_t n, uint32_t limit
   if (table.size() > key || (limit != 0 && table.size() >= limit)) return;
   const size_t old_size = table.size();
   const size_t size = CacheSize(n, limit);
+  if (size <= old_size) return;  // keys beyond the table share its records
   table.resize(size, R{});
   const size_t mask = size - 1;
   for (size_t k = 0; k < old_size; ++k) {
@@ -192,9 +196,11 @@ OmegaMesh::SizeMemo* OmegaMesh::MemoSlot(VertexId v, bool grow) const {
   if (grow) {
     GrowTable(size_memo_, i, size_t{dt_.NumVertices()} + dt_.NumVertices() / 2 + 16, memo_limit_, 0xFFFFFFFFu,
               [](const SizeMemo& m) { return m.vertex; });
-  } else if (size_memo_.size() <= i && (memo_limit_ == 0 || size_memo_.size() < memo_limit_)) {
-    return nullptr;  // a table that would still grow to reach v holds no memo of it
+  } else if (size_memo_.empty()) {
+    return nullptr;
   }
+  // Keys beyond the table share its records (CacheSize rounds down): the
+  // caller checks the record's vertex.
   return &size_memo_[i & (size_memo_.size() - 1)];
 }
 

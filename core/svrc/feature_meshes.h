@@ -122,8 +122,9 @@ class OmegaMesh {
   }
   // The circumcentre cache and Size()'s memos hold at most 2^cc_log2 and
   // 2^memo_log2 entries, direct-mapped by tet slot and vertex (a miss
-  // recomputes; answers do not depend on them). 0: one entry per slot /
-  // vertex, never evicted. docs/svrc-design.md §8 item 44.
+  // recomputes; answers do not depend on them). 0: no bound; the tables then
+  // grow to between a half and one entry per slot / vertex (a power of two,
+  // rounded down). docs/svrc-design.md §8 items 44, 74.
   // `neighbor_entries` bounds Delaunay3's neighbour lists
   // (set_neighbor_cache_limit).
   void SetCacheLimits(uint32_t cc_log2, uint32_t memo_log2, size_t neighbor_entries) {
@@ -136,10 +137,11 @@ class OmegaMesh {
   // Frees the circumcentre cache and Size()'s memos when they hold at least
   // `min_bytes` (they refill on use; answers do not depend on them). Before
   // a size labelling, whose arrays are a run's heap peak; SetLabels drops
-  // the memos' keys anyway. Smaller tables stay: glibc raises its mmap
-  // threshold to the size of a freed mapped block below 32 MiB, and the
-  // blocks after it then come from the heap and stay resident (measured:
-  // cube 1e-5's peak RSS rose 71.0 → 74.7 MB when its 8 MiB table was freed).
+  // the memos' keys anyway. glibc raises its mmap threshold to the size of
+  // a freed mapped block below 32 MiB, and the blocks after it then come
+  // from the heap and stay resident: with every table freed (the default
+  // since session 44) cube 1e-6's peak RSS is ~3% higher, 1e-4's and 1e-5's
+  // lower, and every size's heap peak lower (bench/RESULTS.md "Session 44").
   // Returns whether it freed one.
   bool ReleaseCaches(size_t min_bytes) {
     bool any = false;
@@ -256,15 +258,15 @@ class OmegaMesh {
     uint32_t gen = 0;          // generation + 1 of the cached value
   };
   static_assert(sizeof(CcRecord) == 32);
-  // By value: another tet's lookup may take the same record. The hit on a
-  // slot the table already covers inline (5 M lookups on cube --max-volume
-  // 1e-5, ~48 instructions each through the call); everything else (misses,
-  // growth, slots beyond a bounded table) in CachedCircumcenterSlow, which
-  // looks the slot up again.
+  // By value: another tet's lookup may take the same record. Hits inline,
+  // at the slot's low bits (5 M lookups on cube --max-volume 1e-5, ~48
+  // instructions each through the call; slots past the table's end hit here
+  // too since session 44); misses and growth in CachedCircumcenterSlow,
+  // which looks the slot up again.
   CcEntry CachedCircumcenter(TetId t) const {
     const uint32_t i = t.value();
-    if (i < cc_.size()) {
-      const CcRecord& r = cc_[i];
+    if (!cc_.empty()) {
+      const CcRecord& r = cc_[i & (cc_.size() - 1)];
       if ((r.tag & CcRecord::kSlotMask) == i && r.gen == dt_.Generation(t) + 1) {
         return {r.cc, (r.tag & CcRecord::kInside) != 0, (r.tag & CcRecord::kFlat) != 0};
       }

@@ -287,8 +287,10 @@ struct RefineOptions {
   // the order of the live events is unchanged).
   bool drop_dead_tet_events = true;
   // ... only the tables of at least this many bytes (OmegaMesh::
-  // ReleaseCaches: glibc's mmap threshold; 0 releases every table).
-  size_t release_cache_min_bytes = size_t{32} << 20;
+  // ReleaseCaches: glibc's mmap threshold; 0 releases every table). 0 since
+  // session 44 (was 32 MiB: the small runs' tables stayed in their heap
+  // peak; §8 item 74).
+  size_t release_cache_min_bytes = 0;
   // Snap band of facet arcs, relative to the circle radius (thesis δ, §3.1.2).
   double arc_snap = 0.02;
   // σ: the largest representation angle of the collar surface (radians;

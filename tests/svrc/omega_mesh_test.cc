@@ -215,6 +215,35 @@ std::vector<Vec3> ClipAllSixPasses(const geom::Box3& box, std::vector<Vec3> poly
   return poly;
 }
 
+// Size()'s memo table rounds down to a power of two (between a half and one
+// record per vertex, session 44), so vertices past its end share records
+// with low ones. Their memos must still answer: a memo written for such a
+// vertex is found again by the next lookup (a lookup that gave up on every
+// vertex past the table's end recomputed them all, silently).
+TEST(OmegaMeshTest, MemosOfVerticesPastTheTableAnswer) {
+  OmegaMesh m(Vec3{0.5, 0.5, 0.5}, 2.0);
+  m.SetCacheLimits(0, 0, size_t{1} << 20);
+  std::array<PointId, 8> corners;
+  for (uint32_t i = 0; i < 8; ++i) corners[i] = PointId(i);
+  m.SeedCorners(corners);
+  // 2,200 vertices: the table of 1.5·2,200 + 16 rounded down is 2,048, so
+  // vertices 2,048 … 2,199 lie past it.
+  const std::vector<Vec3> pts = RandomPoints(44, 2200 - 8);
+  for (size_t n = 0; n < pts.size(); ++n) {
+    const PointId id(static_cast<uint32_t>(8 + n));
+    const auto r = m.dt().Insert(pts[n], id.value());
+    m.AddVertex(r.vertex, id);
+  }
+  ASSERT_EQ(m.dt().NumVertices(), 2200u);
+  for (uint32_t v = 0; v < m.dt().NumVertices(); ++v) {
+    const uint64_t before = m.stats().computed_sizes;
+    const CellSize first = m.Size(VertexId(v));
+    const CellSize again = m.Size(VertexId(v));
+    EXPECT_EQ(m.stats().computed_sizes, before + 1) << "vertex " << v;
+    EXPECT_TRUE(SameBits(first.outradius, again.outradius)) << "vertex " << v;
+  }
+}
+
 TEST(OmegaMeshTest, ClipPolygonToBoxEqualsAllSixPasses) {
   geom::Box3 box;
   box.Add(Vec3{-1.5, -0.75, 0.25});
