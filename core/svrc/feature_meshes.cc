@@ -65,9 +65,10 @@ bool OmegaMesh::InsideCube(const Vec3& p) const {
 namespace {
 // The table size for `n` keys: the power of two <= n (at least 64), at most
 // `limit` (0: no limit). Between a half and one record per key, as the large
-// runs' capped tables have: rounding up gave the small runs up to two per key
-// (cube 1e-4: a 1 MiB circumcentre table for 22k tets, 16% of the heap's
-// peak; session 44, bench/RESULTS.md).
+// runs' capped tables have: rounding up (of 1.5 records per vertex for the
+// memos) gave the small runs up to two or three per key (cube 1e-4: a 1 MiB
+// circumcentre table for 22k tets, 16% of the heap's peak; session 44,
+// docs/svrc-design.md §8 item 74).
 size_t CacheSize(size_t n, uint32_t limit) {
   const size_t want = std::bit_floor(std::max<size_t>(n, 64));
   return limit == 0 ? want : std::min<size_t>(want, limit);
@@ -194,7 +195,7 @@ void ClipPolygonToBox(const geom::Box3& box, std::vector<Vec3>* poly, std::vecto
 OmegaMesh::SizeMemo* OmegaMesh::MemoSlot(VertexId v, bool grow) const {
   const uint32_t i = v.value();
   if (grow) {
-    GrowTable(size_memo_, i, size_t{dt_.NumVertices()} + dt_.NumVertices() / 2 + 16, memo_limit_, 0xFFFFFFFFu,
+    GrowTable(size_memo_, i, size_t{dt_.NumVertices()} + 16, memo_limit_, 0xFFFFFFFFu,
               [](const SizeMemo& m) { return m.vertex; });
   } else if (size_memo_.empty()) {
     return nullptr;

@@ -226,7 +226,7 @@ TEST(OmegaMeshTest, MemosOfVerticesPastTheTableAnswer) {
   std::array<PointId, 8> corners;
   for (uint32_t i = 0; i < 8; ++i) corners[i] = PointId(i);
   m.SeedCorners(corners);
-  // 2,200 vertices: the table of 1.5·2,200 + 16 rounded down is 2,048, so
+  // 2,200 vertices: the table of 2,200 + 16 rounded down is 2,048, so
   // vertices 2,048 … 2,199 lie past it.
   const std::vector<Vec3> pts = RandomPoints(44, 2200 - 8);
   for (size_t n = 0; n < pts.size(); ++n) {
