@@ -123,8 +123,8 @@ struct RefineOptions {
   // M_Ω's circumcentre cache and Size() memos hold at most 2^omega_cc_log2
   // and 2^omega_memo_log2 records, direct-mapped (OmegaMesh::
   // SetCacheLimits; §8 item 44): memory a run would otherwise spend per tet
-  // slot and per vertex. 0: one per slot / vertex. Outputs do not depend on
-  // them.
+  // slot and per vertex. 0: no bound (a half to one record per slot /
+  // vertex, §8 item 74). Outputs do not depend on them.
   uint32_t omega_cc_log2 = 20;
   uint32_t omega_memo_log2 = 18;
   // M_Ω's neighbour lists (Delaunay3's cache, read by the cell searches)

@@ -520,7 +520,8 @@ TEST(CollarRefine, LabellingWithTheMeshAdjacencyMakesTheSameRefinement) {
 // M_Ω's circumcentre cache and Size() memos bounded and direct-mapped
 // (RefineOptions::omega_cc_log2 / omega_memo_log2, §8 item 44): tables of
 // 64 circumcentres and 16 memos, where nearly every lookup meets another
-// tet's or vertex's record, against one record per slot and vertex; and
+// tet's or vertex's record, against unbounded tables (a half to one record
+// per slot and vertex, §8 item 74); and
 // the neighbour lists dropped whenever they pass 256 entries (§8 item 47). The
 // same refinement bit for bit, on the collar path (knife_edge, segment_fan)
 // and with size rounds; a record answering for the wrong tet or vertex, or
@@ -540,8 +541,7 @@ TEST(CollarRefine, BoundedOmegaCachesMakeTheSameRefinement) {
     EXPECT_GT(runs[1].stats.circumcentres, 2 * runs[0].stats.circumcentres) << c.rel;
     EXPECT_GT(runs[1].stats.sizes_computed, runs[0].stats.sizes_computed) << c.rel;
     EXPECT_GT(runs[1].stats.sizes_shrunk, 0u) << c.rel;
-    std::printf("%s: %llu circumcentres and %llu star walks with 64 / 16 records, %llu and %llu with one per slot / "
-                "vertex\n",
+    std::printf("%s: %llu circumcentres and %llu star walks with 64 / 16 records, %llu and %llu unbounded\n",
                 c.rel, (unsigned long long)runs[1].stats.circumcentres, (unsigned long long)runs[1].stats.sizes_computed,
                 (unsigned long long)runs[0].stats.circumcentres, (unsigned long long)runs[0].stats.sizes_computed);
   }

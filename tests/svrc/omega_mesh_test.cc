@@ -34,8 +34,9 @@ struct Counts {
 // With `labelled`, every tet gets a label when it is made (kept: its
 // centroid has x > 0.45; both meshes make the same tets in the same slots),
 // and the kept_* fields are compared too.
-// `a` holds at most 2^cc_log2 circumcentres and 2^memo_log2 memos (0: one
-// per slot / vertex; OmegaMesh::SetCacheLimits), `b` one per slot / vertex.
+// `a` holds at most 2^cc_log2 circumcentres and 2^memo_log2 memos (0: no
+// bound, a half to one per slot / vertex; OmegaMesh::SetCacheLimits), `b`
+// has no bound.
 Counts CompareSizes(const std::vector<Vec3>& pts, bool skip_every_third, bool labelled = false, uint32_t cc_log2 = 0,
                     uint32_t memo_log2 = 0) {
   OmegaMesh a(Vec3{0.5, 0.5, 0.5}, 2.0), b(Vec3{0.5, 0.5, 0.5}, 2.0);
