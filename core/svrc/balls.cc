@@ -29,7 +29,6 @@ void TriangleCircumball(const Vec3& a, const Vec3& b, const Vec3& c, Vec3* cente
 
 BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureId feature,
                       MeshId mesh, Cd cd, int n, std::array<PointId, 3> verts) {
-  const BallId id(size());
   Record r;
   r.center = center;
   r.radius = radius;
@@ -42,11 +41,20 @@ BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureI
   r.alive = 1;
   r.kind = kind;
   r.encroach_queued = 0;
+  ++num_alive_;
+  if (!free_.empty()) {
+    const BallId id(free_.back());
+    free_.pop_back();
+    r.generation = rec_[id.value()].generation;  // bumped by Kill: the dead ball's events stay stale
+    rec_[id.value()] = r;
+    mesh_[id.value()] = mesh;
+    return id;
+  }
+  const BallId id(size());
   util::ReserveForAppend(rec_);
   util::ReserveForAppend(mesh_);
   rec_.push_back(r);
   mesh_.push_back(mesh);
-  ++num_alive_;
   return id;
 }
 
@@ -74,6 +82,7 @@ void BallStore::Kill(BallId b) {
   r.alive = 0;
   ++r.generation;
   --num_alive_;
+  if (recycle_) dying_.push_back(b);
 }
 
 EncroachOutcome BallStore::RecordEncroacher(BallId b, PointId v, bool native) {

@@ -66,9 +66,25 @@ class BallStore {
 
   bool IsAlive(BallId b) const { return rec_[b.value()].alive != 0; }
   uint32_t Generation(BallId b) const { return rec_[b.value()].generation; }
-  // The ball's dual simplex left its mesh (or the ball was destroyed): dead for
-  // good, generation bumped so queued events and links can tell.
+  // The ball's dual simplex left its mesh (or the ball was destroyed): dead,
+  // generation bumped so queued events and links can tell.
   void Kill(BallId b);
+
+  // Record recycling (issue #5: on cube --max-volume 1e-4, 4,386 of 8,374
+  // records were dead at the end). With it on, a killed ball's record waits
+  // until TakeDying() hands it to the caller, which makes sure nothing names
+  // it any more (links, lists, per-ball arrays) and gives it back with
+  // Recycle(); Add then takes the newest recycled record first. A recycled
+  // record keeps its generation, so events queued for the dead ball stay
+  // stale. Off: ids are never reused.
+  void EnableRecycling(bool on) { recycle_ = on; }
+  // The balls killed since the last call.
+  std::vector<BallId> TakeDying() {
+    std::vector<BallId> out;
+    out.swap(dying_);
+    return out;
+  }
+  void Recycle(BallId b) { free_.push_back(b.value()); }
 
   // Figure 3.10's encroachment trap. `native`: CD(v) = dim of the mesh whose
   // cell v is (v was created in that mesh). A non-native encroacher only
@@ -105,6 +121,9 @@ class BallStore {
   util::PodVector<Record> rec_;
   util::PodVector<MeshId> mesh_;  // rarely read
   uint32_t num_alive_ = 0;
+  bool recycle_ = false;
+  std::vector<BallId> dying_;
+  std::vector<uint32_t> free_;
 };
 
 }  // namespace svrc::refine

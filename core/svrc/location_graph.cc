@@ -177,6 +177,11 @@ inline const LocationGraph::Span* LocationGraph::FindObjectSpan(LocationObject o
   return spans.size() <= object.id ? nullptr : &spans[object.id];
 }
 
+uint32_t LocationGraph::NumObjectLinks(LocationObject object) const {
+  const Span* os = FindObjectSpan(object);
+  return os == nullptr ? 0 : os->size;
+}
+
 inline uint32_t LocationGraph::CellPos(const Span& cs, LocationObject object) const {
   const CellEntry* e = cell_arena_.Data(cs);
   for (uint32_t i = 0; i < cs.size; ++i) {

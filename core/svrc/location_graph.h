@@ -123,6 +123,8 @@ class LocationGraph {
   }
 
   uint32_t NumLinks() const { return num_links_; }
+  // Links of `object`, in every mesh.
+  uint32_t NumObjectLinks(LocationObject object) const;
 
   // Both directions agree: every link is in exactly its object's array and
   // its cell's array, each entry of either side has its partner on the other

@@ -127,6 +127,7 @@ class Refiner {
   Refiner(const RefineOptions& options, Normalization norm, const Vec3& center, double half)
       : options_(options), norm_(norm), omega_(center, half), pending_(center, half), collar_snap_(options.collar_snap) {
     omega_.SetCacheLimits(options.omega_cc_log2, options.omega_memo_log2, options.omega_neighbor_entries);
+    balls_.EnableRecycling(options.recycle_balls && !options.collars);
   }
 
   absl::Status Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments);
@@ -135,6 +136,9 @@ class Refiner {
   absl::Status Setup(const plc::FeatureComplex& complex, std::span<const Vec3> normalised);
   absl::Status Run();
   absl::Status CheckInvariants(bool final);
+  // Hands the balls killed since the last call back to the ball store
+  // (RefineOptions::recycle_balls).
+  void RecycleBalls();
   PointSetRefinement Output(std::span<const Vec3> input);
   // Output() is the refiner's last use: it first frees what only the
   // refinement reads (the location graph, the balls, the queues, the COLLAR
@@ -1389,8 +1393,11 @@ void Refiner::RefreshFacetEvents(uint32_t f, VertexId2 v, const CellSize2* size)
 bool Refiner::IsLive(const WorkEvent& e) {
   if (e.type == EventType::kEncroached) {
     const BallId b(e.object);
+    // A stale event must not clear the flag of a ball that took over its
+    // record (BallStore recycling).
+    if (balls_.Generation(b) != e.generation) return false;
     balls_.SetEncroachQueued(b, false);
-    return balls_.IsAlive(b) && balls_.Generation(b) == e.generation;
+    return balls_.IsAlive(b);
   }
   if (IsFacetMesh(e.mesh)) {
     const uint32_t f = FacetIndex(e.mesh);
@@ -1455,6 +1462,27 @@ void Refiner::CountEventTime(double seconds) {
   }
 }
 
+void Refiner::RecycleBalls() {
+  // Between events: Destroy's insertions unlinked every ball they killed
+  // (ForceInsertFacet, ForceInsertSegment), and the only list that keeps
+  // dead balls, partial_, is purged here. A ball some link still names is
+  // never recycled.
+  std::vector<BallId> dying = balls_.TakeDying();
+  if (dying.empty()) return;
+  std::erase_if(partial_, [&](BallId b) { return !balls_.IsAlive(b); });
+  for (BallId b : dying) {
+    if (balls_.IsAlive(b) || blg_.NumObjectLinks(LocationObject::Ball(b)) != 0) continue;
+    const uint32_t i = b.value();
+    if (i < tri_of_ball_.size()) tri_of_ball_[i] = 0xFFFFFFFFu;
+    if (i < ball_mark_.size()) ball_mark_[i] = 0;
+    if (i < known_present_.size()) known_present_[i] = 0;
+    if (i < piece_vertex_.size()) piece_vertex_[i] = 0;
+    if (i < piece_seg_.size()) piece_seg_[i] = 0;
+    balls_.Recycle(b);
+    ++stats_.balls_recycled;
+  }
+}
+
 absl::Status Refiner::Run() {
   const auto start = std::chrono::steady_clock::now();
   const geom::PredicateStats pred0 = geom::GetPredicateStats();
@@ -1473,6 +1501,7 @@ absl::Status Refiner::Run() {
     event_insertions_ = 0;
     absl::Status s = Destroy(*event);
     if (!s.ok()) return s;
+    RecycleBalls();
     const auto now = std::chrono::steady_clock::now();
     CountEventTime(std::chrono::duration<double>(now - tick).count());
     tick = now;
@@ -4454,6 +4483,7 @@ void RefineStats::ExportTo(mesh::MeshStats* out) const {
   out->Set("svrc.tied_balls", static_cast<double>(tied_balls));
   out->Set("svrc.ball_records", static_cast<double>(ball_records));
   out->Set("svrc.balls_alive", static_cast<double>(balls_alive));
+  out->Set("svrc.balls_recycled", static_cast<double>(balls_recycled));
   out->Set("svrc.phantom_corners", static_cast<double>(phantom_corners));
   out->Set("svrc.straddle_yields", static_cast<double>(straddle_yields));
   out->Set("svrc.links_added", static_cast<double>(links_added));

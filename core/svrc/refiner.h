@@ -236,6 +236,12 @@ struct RefineOptions {
   // conformity checks limited to elements outside the collars. Implies
   // attempt_creases.
   bool collars = false;
+  // Dead ball records are taken again by new balls (BallStore recycling;
+  // not on the collar path, whose structures keep ball ids). Changes ids,
+  // and with them outputs wherever Destroy's "lowest id" tie-breaks decide
+  // (cube 1e-4: 18,377 → 18,528 tets). Off by default: four tests pin
+  // scenarios of today's refinement (session 44, §8 item 75).
+  bool recycle_balls = false;
   // Stage (e)/(f), experimental (docs/svrc-collars.md "Wiring status"):
   // after the queues run dry, rounds of COLLAR events (CollarRepairs in M_Ω,
   // ArcRepairs in the facet meshes), then RipStitchCollar on M_Ω; the output
@@ -359,6 +365,7 @@ struct RefineStats {
   // reused, so the dead ones (and their per-id side arrays) stay allocated.
   uint64_t ball_records = 0;
   uint64_t balls_alive = 0;
+  uint64_t balls_recycled = 0;  // dead ball records taken again (recycle_balls)
   uint64_t straddle_yields = 0;    // facet triangles crossing a piece: the piece split first
   uint64_t size_rounds = 0;        // max_volume: label + size-event rounds run
   uint64_t labels_unchanged = 0;   // tets a size round relabelled as they were: not retested
