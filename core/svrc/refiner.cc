@@ -726,8 +726,10 @@ class Refiner {
   std::vector<VertexId2> bfs2_, nbrs2_;
   std::vector<uint32_t> mark2_;
   uint32_t stamp2_ = 0;
-  // Balls that got a first, non-native encroacher (PartiallyEncroached).
-  std::vector<BallId> partial_;
+  // Balls that got a first, non-native encroacher (PartiallyEncroached),
+  // with their generation then: an entry of another generation is a ball
+  // that died since (its record possibly another ball's: recycle_balls).
+  std::vector<std::pair<BallId, uint32_t>> partial_;
   std::vector<double> size_target_;  // per M_Ω vertex: max R_v from max_volume (+inf: none)
   // Per M_Ω tet slot (TetLabel): set by SetSizeTargets' labelling, carried
   // to new tets by PropagateSizeTargets; empty while M_Ω is not labelled.
@@ -1243,7 +1245,7 @@ void Refiner::AddFacetPieceLink(uint32_t f, VertexId2 x, BallId b) {
   facts.vertex_point = p;
   const AddLinkResult r = blg_.AddLink(FacetMeshId(f), x.value(), LocationObject::Ball(b), facts, &balls_);
   if (r.encroach == EncroachOutcome::kEnqueue) EnqueueEncroached(b);
-  if (r.encroach == EncroachOutcome::kPartial) partial_.push_back(b);
+  if (r.encroach == EncroachOutcome::kPartial) partial_.push_back({b, balls_.Generation(b)});
 }
 
 void Refiner::LinkPieceToFacet(BallId b, uint32_t f, TriId2 hint) {
@@ -1295,7 +1297,7 @@ void Refiner::AddBallLink(VertexId x, BallId b) {
   facts.vertex_point = p;
   const AddLinkResult r = blg_.AddLink(kOmegaMesh, x.value(), LocationObject::Ball(b), facts, &balls_);
   if (r.encroach == EncroachOutcome::kEnqueue) EnqueueEncroached(b);
-  if (r.encroach == EncroachOutcome::kPartial) partial_.push_back(b);
+  if (r.encroach == EncroachOutcome::kPartial) partial_.push_back({b, balls_.Generation(b)});
 }
 
 void Refiner::LinkBallToOmega(BallId b, VertexId start) {
@@ -1464,14 +1466,11 @@ void Refiner::CountEventTime(double seconds) {
 
 void Refiner::RecycleBalls() {
   // Between events: Destroy's insertions unlinked every ball they killed
-  // (ForceInsertFacet, ForceInsertSegment), and the only list that keeps
-  // dead balls, partial_, is purged here. A ball some link still names is
-  // never recycled.
-  std::vector<BallId> dying = balls_.TakeDying();
-  if (dying.empty()) return;
-  std::erase_if(partial_, [&](BallId b) { return !balls_.IsAlive(b); });
-  for (BallId b : dying) {
-    if (balls_.IsAlive(b) || blg_.NumObjectLinks(LocationObject::Ball(b)) != 0) continue;
+  // (ForceInsertFacet, ForceInsertSegment); the only list that keeps dead
+  // balls, partial_, holds their generations. A ball some link still names
+  // is never recycled.
+  for (BallId b : balls_.TakeDying()) {
+    if (blg_.NumObjectLinks(LocationObject::Ball(b)) != 0) continue;
     const uint32_t i = b.value();
     if (i < tri_of_ball_.size()) tri_of_ball_[i] = 0xFFFFFFFFu;
     if (i < ball_mark_.size()) ball_mark_[i] = 0;
@@ -1515,11 +1514,11 @@ absl::Status Refiner::Run() {
   // if none came, its piece is still not a Delaunay edge of M_Ω — the
   // thesis' "unresolved ConfBall" (Figure 3.9) — so destroy it now
   // (docs/svrc-design.md §8 item 8).
-  std::vector<BallId> partial;
+  std::vector<std::pair<BallId, uint32_t>> partial;
   partial.swap(partial_);
   bool more = false;
-  for (BallId b : partial) {
-    if (!balls_.IsAlive(b)) continue;
+  for (const auto& [b, gen] : partial) {
+    if (!balls_.IsAlive(b) || balls_.Generation(b) != gen) continue;
     if (EncroachedByPoint(b, balls_.FirstEncroacher(b))) {
       EnqueueEncroached(b);
       more = true;
