@@ -48,6 +48,7 @@ BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureI
     r.generation = rec_[id.value()].generation;  // bumped by Kill: the dead ball's events stay stale
     rec_[id.value()] = r;
     mesh_[id.value()] = mesh;
+    seq_[id.value()] = next_seq_++;
     return id;
   }
   const BallId id(size());
@@ -55,6 +56,8 @@ BallId BallStore::Add(BallKind kind, const Vec3& center, double radius, FeatureI
   util::ReserveForAppend(mesh_);
   rec_.push_back(r);
   mesh_.push_back(mesh);
+  util::ReserveForAppend(seq_);
+  seq_.push_back(next_seq_++);
   return id;
 }
 

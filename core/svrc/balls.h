@@ -57,6 +57,10 @@ class BallStore {
   BallKind Kind(BallId b) const { return rec_[b.value()].kind; }
   FeatureId Feature(BallId b) const { return rec_[b.value()].feature; }
   MeshId Mesh(BallId b) const { return mesh_[b.value()]; }
+  // The order balls were made in (0, 1, 2, ...): the id while no record is
+  // recycled. Destroy's tie-breaks read it instead of the id, so recycling
+  // records does not change which ball wins (issue #5).
+  uint32_t Seq(BallId b) const { return seq_[b.value()]; }
   Cd CdOf(BallId b) const { return rec_[b.value()].cd; }  // CD of the centre (Def 36)
   // The dual simplex: 1 (vertex ball), 2 (piece) or 3 (triangle) global points.
   int NumVertices(BallId b) const { return rec_[b.value()].num_verts; }
@@ -72,17 +76,17 @@ class BallStore {
 
   // Record recycling (issue #5: on cube --max-volume 1e-4, 4,386 of 8,374
   // records were dead at the end). With it on, a killed ball's record waits
-  // until TakeDying() hands it to the caller, which makes sure nothing names
+  // until TakeDying hands it to the caller, which makes sure nothing names
   // it any more (links, lists, per-ball arrays) and gives it back with
   // Recycle(); Add then takes the newest recycled record first. A recycled
   // record keeps its generation, so events queued for the dead ball stay
   // stale. Off: ids are never reused.
   void EnableRecycling(bool on) { recycle_ = on; }
-  // The balls killed since the last call.
-  std::vector<BallId> TakeDying() {
-    std::vector<BallId> out;
-    out.swap(dying_);
-    return out;
+  // The balls killed since the last call, into *out (its old contents are
+  // dropped; the two buffers trade places, so neither reallocates once warm).
+  void TakeDying(std::vector<BallId>* out) {
+    out->clear();
+    out->swap(dying_);
   }
   void Recycle(BallId b) { free_.push_back(b.value()); }
 
@@ -120,6 +124,8 @@ class BallStore {
   static_assert(sizeof(Record) == 64);
   util::PodVector<Record> rec_;
   util::PodVector<MeshId> mesh_;  // rarely read
+  util::PodVector<uint32_t> seq_;  // rarely read (tie-breaks)
+  uint32_t next_seq_ = 0;
   uint32_t num_alive_ = 0;
   bool recycle_ = false;
   std::vector<BallId> dying_;

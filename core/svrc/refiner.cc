@@ -331,7 +331,7 @@ class Refiner {
     if (!yield.valid()) return true;
     const Cd a = balls_.CdOf(b), y = balls_.CdOf(yield);
     return a < y || (a == y && (balls_.Radius(b) > balls_.Radius(yield) ||
-                                (balls_.Radius(b) == balls_.Radius(yield) && b < yield)));
+                                (balls_.Radius(b) == balls_.Radius(yield) && balls_.Seq(b) < balls_.Seq(yield))));
   }
 
   // --- ForceInsert (Figure 3.5) + UpdateLocation (3.6) + PropagateLocation (3.9)
@@ -838,6 +838,7 @@ class Refiner {
   std::vector<uint32_t> ball_mark_;
   uint32_t ball_stamp_ = 0;
   std::vector<BallId> gathered_;
+  std::vector<BallId> dying_scratch_;  // RecycleBalls' buffer (BallStore::TakeDying)
   std::vector<LocationObject> objects_;
   std::vector<LocationObject> moves_;  // UpdateLocation: 0-balls moving to the new cell
   // UpdateLocation (Figure 3.6) for one old cell u of `mesh` that shrank when
@@ -1469,7 +1470,8 @@ void Refiner::RecycleBalls() {
   // (ForceInsertFacet, ForceInsertSegment); the only list that keeps dead
   // balls, partial_, holds their generations. A ball some link still names
   // is never recycled.
-  for (BallId b : balls_.TakeDying()) {
+  balls_.TakeDying(&dying_scratch_);
+  for (BallId b : dying_scratch_) {
     if (blg_.NumObjectLinks(LocationObject::Ball(b)) != 0) continue;
     const uint32_t i = b.value();
     if (i < tri_of_ball_.size()) tri_of_ball_[i] = 0xFFFFFFFFu;
@@ -2126,7 +2128,10 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
   // then come in an order that does not depend on which old cells still
   // held each ball. Of the orders measured, newest first gave the fewest
   // tets (§8 item 37).
-  if (bisector_filter) std::sort(moved_pieces.begin(), moved_pieces.end(), [](BallId a, BallId b) { return b < a; });
+  if (bisector_filter) {
+    std::sort(moved_pieces.begin(), moved_pieces.end(),
+              [this](BallId a, BallId b) { return balls_.Seq(b) < balls_.Seq(a); });
+  }
   // V(p) is the intersection of the half-spaces nearer to p than to each
   // cavity vertex (its Delaunay neighbours): a ball beyond one of those
   // bisectors misses it (§8 item 57; without collars, as CellsMeetingBall).

@@ -237,11 +237,10 @@ struct RefineOptions {
   // attempt_creases.
   bool collars = false;
   // Dead ball records are taken again by new balls (BallStore recycling;
-  // not on the collar path, whose structures keep ball ids). Changes ids,
-  // and with them outputs wherever Destroy's "lowest id" tie-breaks decide
-  // (cube 1e-4: 18,377 → 18,528 tets). Off by default: four tests pin
-  // scenarios of today's refinement (session 44, §8 item 75).
-  bool recycle_balls = false;
+  // not on the collar path, whose structures keep ball ids). Changes ids
+  // but not outputs: Destroy's tie-breaks and the newest-first link order
+  // read BallStore::Seq, the order balls were made in (§8 items 75, 76).
+  bool recycle_balls = true;
   // Stage (e)/(f), experimental (docs/svrc-collars.md "Wiring status"):
   // after the queues run dry, rounds of COLLAR events (CollarRepairs in M_Ω,
   // ArcRepairs in the facet meshes), then RipStitchCollar on M_Ω; the output
