@@ -3125,6 +3125,9 @@ void Refiner::ReleaseRefinementState() {
   objects_ = {};
   moves_ = {};
   ball_mark_ = {};
+  util::PodVector<CellCert>().swap(cell_cert_);
+  util::PodVector<uint32_t>().swap(tet_event_);  // the queues' slots (gone above)
+  omega_.ReleaseQueryCaches();
 }
 
 std::vector<std::pair<uint32_t, std::array<uint32_t, 3>>> Refiner::StitchedFacetFaces(uint64_t* on_plane) const {
