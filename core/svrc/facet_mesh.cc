@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/geometry/predicates.h"
+#include "core/util/grow.h"
 
 namespace svrc::refine {
 
@@ -195,6 +196,13 @@ Vec2 FacetMesh::Corner(int i) const {
 
 void FacetMesh::Register(VertexId2 v, PointId p) {
   if (point_of_.size() <= v.value()) {
+    // 1.25x growth, not resize's doubling: six facet meshes growing in step
+    // held up to half their capacity unused (cube 1e-4, session 45).
+    const size_t extra = v.value() + 1 - point_of_.size();
+    util::ReserveForAppend(point_of_, extra);
+    util::ReserveForAppend(cell_gen_, extra);
+    util::ReserveForAppend(skinny_event_, extra);
+    util::ReserveForAppend(unresolved_event_, extra);
     point_of_.resize(v.value() + 1);
     cell_gen_.resize(v.value() + 1, 0);
     skinny_event_.resize(v.value() + 1);
