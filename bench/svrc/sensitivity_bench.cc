@@ -234,6 +234,15 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   const refine::RefineStats& s = refined->stats;
   const mesh::TetMesh& m = out->mesh;
   const mesh::QualityReport q = mesh::ComputeQuality(m);
+  // Vertices of the output's boundary and interface triangles (the surface
+  // model of the flatness diagnostics).
+  size_t boundary_vertices = 0;
+  {
+    std::vector<uint8_t> on(m.positions.size(), 0);
+    for (const auto& t : m.triangles) {
+      for (uint32_t v : t) boundary_vertices += on[v] == 0 ? (on[v] = 1) : 0;
+    }
+  }
   std::string verified = "-";
   if (verify) {
     core::MeshParams params;
@@ -253,12 +262,12 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   }
   absl::StrAppend(&kinds, " sec_other_events=", s.seconds_other_events, " other_events=", s.other_events);
   std::printf(
-      "RESULT status=OK out_vertices=%zu out_tets=%zu omega_vertices=%llu omega_tets=%zu "
+      "RESULT status=OK out_vertices=%zu out_tets=%zu boundary_vertices=%zu omega_vertices=%llu omega_tets=%zu "
       "segment_vertices=%llu facet_vertices=%llu insertions=%llu destroy_cells=%llu destroy_index=%llu links_added=%llu "
       "links_removed=%llu warps=%llu yields=%llu max_degree=%u "
       "wall_prepare=%.6f wall_refine=%.6f wall_output=%.6f cpu_prepare=%.6f cpu_refine=%.6f cpu_output=%.6f "
       "base_kib=%ld peak_kib=%ld heap_peak=%lld max_re=%.6g min_dih=%.6g verify=%s%s\n",
-      m.positions.size(), m.tets.size(), (unsigned long long)s.vertices, refined->tets.size(),
+      m.positions.size(), m.tets.size(), boundary_vertices, (unsigned long long)s.vertices, refined->tets.size(),
       (unsigned long long)s.segment_vertices, (unsigned long long)s.facet_vertices,
       (unsigned long long)s.insertions, (unsigned long long)s.destroy_cells_visited,
       (unsigned long long)s.destroy_index_visited,
@@ -520,6 +529,46 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
     prev = &r;
   }
   std::printf("\n");
+  // The surface model: with T output tets and S boundary vertices, a cost
+  // y ≈ a·T + b·S, fitted exactly on the smallest and the largest run. The
+  // per-tet ratio of the two runs is (a + b·s₁)/(a + b·s₂) with s = S/T, so
+  // it is ≤ 1.5 exactly when b ≤ 0.5·a/(s₁ − 1.5·s₂): what a boundary vertex
+  // may cost for the cube's series to be flat (issue #5; bench/RESULTS.md
+  // "Session 45").
+  {
+    const Row *small = nullptr, *large = nullptr;
+    for (const Row& r : rows) {
+      if (r.r.status != "OK" || r.tets < 1e4 || !(r.r.D("boundary_vertices") > 0)) continue;
+      if (small == nullptr || r.tets < small->tets) small = &r;
+      if (large == nullptr || r.tets > large->tets) large = &r;
+    }
+    const double s1 = small == nullptr ? 0 : small->r.D("boundary_vertices") / small->tets;
+    const double s2 = large == nullptr ? 0 : large->r.D("boundary_vertices") / large->tets;
+    if (small != nullptr && large != small && s1 > 1.01 * s2) {
+      std::printf("  - surface model y ≈ a·T + b·S (T output tets, S boundary vertices %.0f .. %.0f; fit on %.3g and "
+                  "%.3g tets):",
+                  small->r.D("boundary_vertices"), large->r.D("boundary_vertices"), small->tets, large->tets);
+      struct Cost {
+        const char* name;
+        const char* unit;
+        double scale;
+        double (*total)(const Row&);
+      };
+      const Cost costs[] = {{"peak heap", "B", 1, [](const Row& r) { return r.heap_b * r.tets; }},
+                            {"cpu", "µs", 1e6, [](const Row& r) { return r.cpu; }}};
+      bool first_cost = true;
+      for (const Cost& c : costs) {
+        // y1 = a·T1 + b·S1, y2 = a·T2 + b·S2, per tet: y/T = a + b·s.
+        const double p1 = c.scale * c.total(*small) / small->tets, p2 = c.scale * c.total(*large) / large->tets;
+        const double b = (p1 - p2) / (s1 - s2), a = p2 - b * s2;
+        const double need = s1 > 1.5 * s2 ? 0.5 * a / (s1 - 1.5 * s2) : HUGE_VAL;
+        std::printf("%s %s a = %.3g %s per tet, b = %.4g %s per boundary vertex (flat within 1.5× needs b ≤ %.4g)",
+                    first_cost ? "" : ";", c.name, a, c.unit, b, c.unit, need);
+        first_cost = false;
+      }
+      std::printf("\n");
+    }
+  }
   // The location graph's link changes per insertion, by the insertion that
   // made them (RefineStats::link_changes_by_kind), and each kind's share of
   // the insertions: a kind whose cost stays flat but whose share moves
