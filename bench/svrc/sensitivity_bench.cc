@@ -544,7 +544,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
     }
     const double s1 = small == nullptr ? 0 : small->r.D("boundary_vertices") / small->tets;
     const double s2 = large == nullptr ? 0 : large->r.D("boundary_vertices") / large->tets;
-    if (small != nullptr && large != small && s1 > 1.01 * s2) {
+    if (small != nullptr && large != small && s1 > 1.5 * s2) {  // else the surface cannot unflatten it
       std::printf("  - surface model y ≈ a·T + b·S (T output tets, S boundary vertices %.0f .. %.0f; fit on %.3g and "
                   "%.3g tets):",
                   small->r.D("boundary_vertices"), large->r.D("boundary_vertices"), small->tets, large->tets);
@@ -561,7 +561,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
         // y1 = a·T1 + b·S1, y2 = a·T2 + b·S2, per tet: y/T = a + b·s.
         const double p1 = c.scale * c.total(*small) / small->tets, p2 = c.scale * c.total(*large) / large->tets;
         const double b = (p1 - p2) / (s1 - s2), a = p2 - b * s2;
-        const double need = s1 > 1.5 * s2 ? 0.5 * a / (s1 - 1.5 * s2) : HUGE_VAL;
+        const double need = 0.5 * a / (s1 - 1.5 * s2);
         std::printf("%s %s a = %.3g %s per tet, b = %.4g %s per boundary vertex (flat within 1.5× needs b ≤ %.4g)",
                     first_cost ? "" : ";", c.name, a, c.unit, b, c.unit, need);
         first_cost = false;
