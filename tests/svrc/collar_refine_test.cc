@@ -344,6 +344,17 @@ struct SameRefinementCase {
   double max_volume;
   bool cell_test = false;  // RefineOptions::tet_quality off: Figure 3.5's cell test throughout
 };
+// The same tets over bit-identical points.
+void ExpectSameRefinement(const PointSetRefinement& a, const PointSetRefinement& b, const char* rel) {
+  EXPECT_EQ(a.tets, b.tets) << rel;
+  EXPECT_EQ(a.normalised_positions.size(), b.normalised_positions.size()) << rel;
+  for (size_t i = 0; i < std::min(a.normalised_positions.size(), b.normalised_positions.size()); ++i) {
+    if (!(a.normalised_positions[i] == b.normalised_positions[i])) {
+      ADD_FAILURE() << rel << " point " << i;
+      break;
+    }
+  }
+}
 std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase& c,
                                                         const std::function<void(RefineOptions*, bool)>& set) {
   std::array<PointSetRefinement, 2> out;
@@ -366,14 +377,7 @@ std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase
     if (!run.ok()) return out;
     out[on] = *std::move(run);
   }
-  EXPECT_EQ(out[0].tets, out[1].tets) << c.rel;
-  EXPECT_EQ(out[0].normalised_positions.size(), out[1].normalised_positions.size()) << c.rel;
-  for (size_t i = 0; i < std::min(out[0].normalised_positions.size(), out[1].normalised_positions.size()); ++i) {
-    if (!(out[0].normalised_positions[i] == out[1].normalised_positions[i])) {
-      ADD_FAILURE() << c.rel << " point " << i;
-      break;
-    }
-  }
+  ExpectSameRefinement(out[0], out[1], c.rel);
   return out;
 }
 
@@ -422,14 +426,7 @@ TEST(CollarRefine, RecycledBallRecordsGiveTheSameRefinementInHalfTheRecords) {
       EXPECT_TRUE(rep.ok()) << c.rel << " recycle " << on << ": " << rep.Summary();
       EXPECT_LE(mesh::ComputeQuality(out->mesh).all.radius_edge.max, 2.0 * (1 + 1e-9)) << c.rel;
     }
-    EXPECT_EQ(runs[0].tets, runs[1].tets) << c.rel;
-    EXPECT_EQ(runs[0].normalised_positions.size(), runs[1].normalised_positions.size()) << c.rel;
-    for (size_t i = 0; i < std::min(runs[0].normalised_positions.size(), runs[1].normalised_positions.size()); ++i) {
-      if (!(runs[0].normalised_positions[i] == runs[1].normalised_positions[i])) {
-        ADD_FAILURE() << c.rel << " point " << i;
-        break;
-      }
-    }
+    ExpectSameRefinement(runs[0], runs[1], c.rel);
     EXPECT_EQ(stats[0].balls_recycled, 0u) << c.rel;
     EXPECT_GT(stats[1].balls_recycled, 0u) << c.rel;
     EXPECT_LT(static_cast<double>(stats[1].ball_records), 0.75 * static_cast<double>(stats[0].ball_records)) << c.rel;
