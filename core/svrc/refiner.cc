@@ -321,7 +321,8 @@ class Refiner {
 
   // Destroy's choices (Figure 3.4 lines 6 and 13): the warp target with the
   // lowest CD, then nearest to c, then the lowest point id; the yield ball
-  // with the lowest CD, then the largest, then the lowest id (determinism).
+  // with the lowest CD, then the largest, then the one made first
+  // (BallStore::Seq: ids are recycled; determinism).
   bool PreferWarp(BallId b, double d2, BallId warp, double warp_d2) const {
     if (!warp.valid()) return true;
     const Cd a = balls_.CdOf(b), w = balls_.CdOf(warp);
@@ -1850,7 +1851,7 @@ absl::Status Refiner::DestroyOmegaAt(const Vec3& c_in, double r, TetId cell_hint
       } else if (balls_.IsAlive(b)) {
         // Strict interior: c on the sphere does not force a yield.
         if (!Inside(b, c)) continue;
-        // Lowest CD, then the largest ball, then lowest id.
+        // Lowest CD, then the largest ball, then the one made first.
         if (PreferYield(b, yield)) yield = b;
       }
     }
@@ -2123,7 +2124,7 @@ absl::Status Refiner::ForceInsertOmega(PointId p, TetId hint) {
     FilterShrunkCell(kOmegaMesh, u.value(), nv.value(), &moved_pieces, piece_meets, nearer_to_new);
   }
   const size_t inew = changed.size() - 1;
-  // With the filter, newest ball first (descending id): the new cell's links
+  // With the filter, newest ball first (descending BallStore::Seq): the new cell's links
   // (and the Encroached events AddBallLink enqueues, FIFO in their bucket)
   // then come in an order that does not depend on which old cells still
   // held each ball. Of the orders measured, newest first gave the fewest
