@@ -13,6 +13,7 @@
 #include "client/command.h"
 #include "client/remote_commands.h"
 #include "core/api.h"
+#include "core/util/huge_pages.h"
 
 namespace svrc::cli {
 
@@ -75,6 +76,7 @@ int ExecRemote(char** argv) {
 
 int main(int argc, char** argv) {
   using namespace svrc::cli;
+  svrc::util::FixMmapThreshold();  // large arrays go back to the system when freed (core/util/huge_pages.h)
   if (argc < 2) {
     PrintUsage(stderr);
     return kExitUsage;

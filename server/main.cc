@@ -48,6 +48,9 @@ int Usage(const std::string& why) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Large arrays go back to the system when a job frees them, whatever size
+  // an earlier job freed (core/util/huge_pages.h).
+  svrc::util::FixMmapThreshold();
   // The workers' heaps on transparent huge pages only when the operator asks
   // (SVRC_HUGE_PAGES=1; core/util/huge_pages.h): one heap serves every job,
   // and collar jobs ran 1.3-1.8x slower on it (docs/svrc-design.md §8 item 49).

@@ -1,5 +1,6 @@
 #include "core/util/huge_pages.h"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -39,6 +40,14 @@ void ReexecWithHugePageHeap(char** argv) {
   } else {
     unsetenv("GLIBC_TUNABLES");
   }
+}
+
+void FixMmapThreshold() {
+  const char* off = std::getenv("SVRC_MMAP_THRESHOLD");
+  if (off != nullptr && std::strcmp(off, "0") == 0) return;
+  const char* current = std::getenv("GLIBC_TUNABLES");
+  if (current != nullptr && std::strstr(current, "glibc.malloc.mmap_threshold") != nullptr) return;
+  mallopt(M_MMAP_THRESHOLD, kMmapThreshold);
 }
 
 bool HugePageHeapRequested() {
