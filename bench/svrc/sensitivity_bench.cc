@@ -240,7 +240,12 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   {
     std::vector<uint8_t> on(m.positions.size(), 0);
     for (const auto& t : m.triangles) {
-      for (uint32_t v : t) boundary_vertices += on[v] == 0 ? (on[v] = 1) : 0;
+      for (uint32_t v : t) {
+        if (on[v] == 0) {
+          on[v] = 1;
+          ++boundary_vertices;
+        }
+      }
     }
   }
   std::string verified = "-";

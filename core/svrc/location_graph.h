@@ -163,8 +163,9 @@ class LocationGraph {
   // the next class (taken from that class's free list, else appended); the
   // old block goes to its free list. Blocks of emptied arrays are kept (a cell
   // emptied by UpdateLocation is usually refilled at once) except a dead
-  // object's (RemoveObjectLinks): a recycled ball id starts with no block. Blocks of arrays
-  // that shrank stay too, until the arena is packed (MaybeCompactCells).
+  // object's (RemoveObjectLinks): a recycled ball id starts with no block.
+  // Blocks of arrays that shrank stay too, until the arena is packed
+  // (MaybeCompactCells).
   template <typename Entry>
   class Arena {
    public:

@@ -35,9 +35,9 @@ bool HugePageHeapRequested();
 // whose freed pieces stay resident. Measured (session 45, cube.poly
 // --max-volume 1e-6, the same output bytes): peak RSS 373 -> 307 MB on the
 // ordinary heap, 346-412 -> 305-314 MB on the huge-page heap, wall time
-// within this box's noise; --max-volume 1e-5
-// 47.5 -> 44-47 MB (a 4 MiB threshold: 51.5 MB; 256 KiB: 42-43 MB, with 40%
-// more page faults on 1e-6); wedge-1.smesh 167-171 -> 156-157 MB. Nothing is
+// within this box's noise; --max-volume 1e-5 47.5 -> 44-47 MB (a 4 MiB
+// threshold: 51.5 MB; 256 KiB: 42-43 MB, with 40% more page faults on
+// 1e-6); wedge-1.smesh 167-171 -> 156-157 MB. Nothing is
 // done when GLIBC_TUNABLES already names glibc.malloc.mmap_threshold (the
 // user's choice) or SVRC_MMAP_THRESHOLD=0. Call it first thing in main().
 inline constexpr int kMmapThreshold = 1 << 20;
