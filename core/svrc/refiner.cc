@@ -920,6 +920,7 @@ class Refiner {
   std::vector<BallId> insert_moved_;
   std::vector<VertexId> link_cells_;
   std::vector<VertexId> cmb_candidates_;  // CellsMeetingBall's search queue
+  std::vector<VertexId> cmb_parents_;     // and the cell each was found from
 };
 
 absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<const SegmentInput> segments) {
@@ -1127,17 +1128,33 @@ void Refiner::CellsMeetingBall(const Vec3& c, double r, VertexId w, std::vector<
   if (mark_.size() < dt.NumVertices()) mark_.resize(dt.NumVertices() + 64, 0);
   out->clear();
   std::vector<VertexId>& cand = cmb_candidates_;
+  // cmb_parents_[i]: the kept cell whose neighbour list admitted cand[i].
+  std::vector<VertexId>& parent = cmb_parents_;
   cand.clear();
+  parent.clear();
   cand.push_back(w);
+  parent.push_back(w);
   mark_[w.value()] = stamp_;
   for (size_t i = 0; i < cand.size(); ++i) {
     const VertexId xi = cand[i];
     const Vec3& px = dt.Point(xi);
+    double xc2 = 0;
+    if (tight && xi != w) {
+      // The parent is one of xi's Delaunay neighbours, so its bisector is one
+      // of the tests below: asked first, it turns most of the candidates that
+      // fail away before their neighbour list is fetched (same cells, same
+      // order; the parent w was the admission test).
+      xc2 = geom::Dist2(px, c);
+      const VertexId y = parent[i];
+      if (y != w) {
+        const Vec3& py = dt.Point(y);
+        if (BallBeyondBisectorOf(xc2, geom::Dist2(py, c), px, py, r, wc2)) continue;
+      }
+    }
     // A view into M_Ω's neighbour cache (no copy); valid until the next
     // vertex query of dt, and the loop body makes none.
     const std::span<const VertexId> nbrs = dt.NeighborsView(xi);
     if (tight && xi != w) {
-      const double xc2 = geom::Dist2(px, c);
       bool meets = true;
       for (VertexId y : nbrs) {
         const Vec3& py = dt.Point(y);
@@ -1153,7 +1170,10 @@ void Refiner::CellsMeetingBall(const Vec3& c, double r, VertexId w, std::vector<
       if (mark_[x.value()] == stamp_) continue;
       mark_[x.value()] = stamp_;
       const Vec3& px2 = dt.Point(x);
-      if (!BallBeyondBisectorOf(geom::Dist2(px2, c), wc2, px2, pw, r, wc2)) cand.push_back(x);
+      if (!BallBeyondBisectorOf(geom::Dist2(px2, c), wc2, px2, pw, r, wc2)) {
+        cand.push_back(x);
+        parent.push_back(xi);
+      }
     }
   }
 }
