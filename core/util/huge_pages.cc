@@ -21,14 +21,20 @@ bool ThpInMadviseMode() {
   return std::getline(in, line) && line.find("[madvise]") != std::string::npos;
 }
 
+// Whether a heap setting of ours is left alone: its switch `env` is "0", or
+// the user's GLIBC_TUNABLES already names `tunable`.
+bool LeftToTheUser(const char* env, const char* tunable) {
+  const char* off = std::getenv(env);
+  if (off != nullptr && std::strcmp(off, "0") == 0) return true;
+  const char* current = std::getenv("GLIBC_TUNABLES");
+  return current != nullptr && std::strstr(current, tunable) != nullptr;
+}
+
 }  // namespace
 
 void ReexecWithHugePageHeap(char** argv) {
-  const char* off = std::getenv("SVRC_HUGE_PAGES");
-  if (off != nullptr && std::strcmp(off, "0") == 0) return;
+  if (LeftToTheUser("SVRC_HUGE_PAGES", kTunable) || !ThpInMadviseMode()) return;
   const char* current = std::getenv("GLIBC_TUNABLES");
-  if (current != nullptr && std::strstr(current, kTunable) != nullptr) return;
-  if (!ThpInMadviseMode()) return;
   const std::string saved = current != nullptr ? current : "";
   const std::string value =
       (current != nullptr && *current != '\0' ? saved + ":" : std::string()) + kTunable + "=1";
@@ -43,10 +49,7 @@ void ReexecWithHugePageHeap(char** argv) {
 }
 
 void FixMmapThreshold() {
-  const char* off = std::getenv("SVRC_MMAP_THRESHOLD");
-  if (off != nullptr && std::strcmp(off, "0") == 0) return;
-  const char* current = std::getenv("GLIBC_TUNABLES");
-  if (current != nullptr && std::strstr(current, "glibc.malloc.mmap_threshold") != nullptr) return;
+  if (LeftToTheUser("SVRC_MMAP_THRESHOLD", "glibc.malloc.mmap_threshold")) return;
   mallopt(M_MMAP_THRESHOLD, kMmapThreshold);
 }
 
