@@ -163,6 +163,8 @@ class Delaunay3 {
   bool Is3d() const { return num_live_tets_ != 0; }
 
   const Vec3& Point(VertexId v) const { return points_[v.value()]; }
+  // Every vertex's point, by id (valid until the next insertion).
+  std::span<const Vec3> Points() const { return points_; }
   uint32_t GlobalId(VertexId v) const { return global_ids_[v.value()]; }
   // One live tet incident to v (kNoneTet while v is pending).
   TetId VertexTet(VertexId v) const { return TetId(vertex_tet_[v.value()]); }

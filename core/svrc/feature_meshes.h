@@ -123,8 +123,9 @@ class OmegaMesh {
   // The circumcentre cache and Size()'s memos hold at most 2^cc_log2 and
   // 2^memo_log2 entries, direct-mapped by tet slot and vertex (a miss
   // recomputes; answers do not depend on them). 0: no bound; the tables then
-  // grow to between a half and one entry per slot / vertex (a power of two,
-  // rounded down). docs/svrc-design.md §8 items 44, 74.
+  // grow to a power of two (rounded down) of between a quarter and a half
+  // entry per tet slot, and between a half and one per vertex.
+  // docs/svrc-design.md §8 items 44, 74, 79.
   // `neighbor_entries` bounds Delaunay3's neighbour lists
   // (set_neighbor_cache_limit).
   void SetCacheLimits(uint32_t cc_log2, uint32_t memo_log2, size_t neighbor_entries) {

@@ -63,12 +63,12 @@ struct Hit {
 // edge or vertex of the tet reached, a boundary face crossed, or more than
 // `max_steps` steps. A point strictly inside a tet lies in no other tet's
 // closure, so then that tet is its only hit (as the scan would find it).
-template <typename Nbr4>
-uint32_t WalkToStrictTet(std::span<const Vec3> pos, std::span<const std::array<uint32_t, 4>> tets,
-                         const Nbr4& nbr4, const Vec3& q, size_t max_steps) {
+template <typename Tets, typename Nbr4>
+uint32_t WalkToStrictTet(std::span<const Vec3> pos, const Tets& tets, const Nbr4& nbr4, const Vec3& q,
+                         size_t max_steps) {
   uint32_t t = 0;
   for (size_t step = 0; step < max_steps; ++step) {
-    const std::array<uint32_t, 4>& v = tets[t];
+    const std::array<uint32_t, 4> v = tets[t];
     Vec3 x[4] = {pos[v[0]], pos[v[1]], pos[v[2]], pos[v[3]]};
     int beyond = -1;
     bool strict = true;
@@ -89,9 +89,8 @@ uint32_t WalkToStrictTet(std::span<const Vec3> pos, std::span<const std::array<u
   return kNoTet;
 }
 
-template <typename Nbr4>
-std::vector<std::vector<Hit>> LocatePoints(std::span<const Vec3> pos,
-                                           std::span<const std::array<uint32_t, 4>> tets,
+template <typename Tets, typename Nbr4>
+std::vector<std::vector<Hit>> LocatePoints(std::span<const Vec3> pos, const Tets& tets,
                                            std::span<const Vec3> queries, const Nbr4& nbr4) {
   std::vector<std::vector<Hit>> hits(queries.size());
   if (queries.empty() || tets.empty() || pos.empty()) return hits;
@@ -145,10 +144,11 @@ std::vector<std::vector<Hit>> LocatePoints(std::span<const Vec3> pos,
   }
   if (items.empty()) return hits;
   for (size_t t = 0; t < tets.size(); ++t) {
-    const Vec3& a = pos[tets[t][0]];
-    const Vec3& b = pos[tets[t][1]];
-    const Vec3& c = pos[tets[t][2]];
-    const Vec3& d = pos[tets[t][3]];
+    const std::array<uint32_t, 4> tv = tets[t];
+    const Vec3& a = pos[tv[0]];
+    const Vec3& b = pos[tv[1]];
+    const Vec3& c = pos[tv[2]];
+    const Vec3& d = pos[tv[3]];
     const Vec3 tlo{std::min({a.x, b.x, c.x, d.x}), std::min({a.y, b.y, c.y, d.y}),
                    std::min({a.z, b.z, c.z, d.z})};
     const Vec3 thi{std::max({a.x, b.x, c.x, d.x}), std::max({a.y, b.y, c.y, d.y}),
@@ -181,7 +181,8 @@ std::vector<std::vector<Hit>> LocatePoints(std::span<const Vec3> pos,
 // wins; otherwise (the point is on a face, edge or vertex of the mesh) the tet
 // whose sorted vertex ids are lexicographically smallest. The rule depends on
 // the tets' vertex sets only, not on the order of the tet list.
-uint32_t ChooseTet(const std::vector<Hit>& hits, std::span<const std::array<uint32_t, 4>> tets) {
+template <typename Tets>
+uint32_t ChooseTet(const std::vector<Hit>& hits, const Tets& tets) {
   uint32_t best = kNoTet;
   bool best_strict = false;
   std::array<uint32_t, 4> best_key{};
@@ -196,6 +197,16 @@ uint32_t ChooseTet(const std::vector<Hit>& hits, std::span<const std::array<uint
   }
   return best;
 }
+
+// LabelInput's tets, from its array or its tet_vertices_of function.
+struct TetList {
+  const LabelInput* in;
+  size_t size() const { return in->tet_vertices_of ? in->num_tets : in->tets.size(); }
+  bool empty() const { return size() == 0; }
+  std::array<uint32_t, 4> operator[](size_t t) const {
+    return in->tet_vertices_of ? in->tet_vertices_of(static_cast<uint32_t>(t)) : in->tets[t];
+  }
+};
 
 }  // namespace
 
@@ -214,12 +225,13 @@ std::string_view LabelIssueKindName(LabelIssueKind kind) {
 
 absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   const size_t nv = in.positions.size();
-  const size_t nt = in.tets.size();
+  const TetList tets{&in};
+  const size_t nt = tets.size();
   if (nt >= (size_t{1} << 30)) {
     return absl::InvalidArgumentError(absl::StrCat("too many tets for labelling: ", nt));
   }
   for (size_t t = 0; t < nt; ++t) {
-    for (uint32_t v : in.tets[t]) {
+    for (uint32_t v : tets[t]) {
       if (v >= nv) {
         return absl::InvalidArgumentError(
             absl::StrCat("tet ", t, " has vertex id ", v, " out of range (", nv, " vertices)"));
@@ -245,6 +257,9 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // tetrahedralization (reported for the smallest (a, b, c), with its three
   // smallest slots).
   const bool given = in.neighbor_slots_of != nullptr && in.find_face != nullptr;
+  if (in.tet_vertices_of != nullptr && !given) {
+    return absl::InvalidArgumentError("tet_vertices_of needs neighbor_slots_of and find_face");
+  }
   std::optional<TetFaces> tet_faces;
   std::vector<uint32_t> own_nbr;
   if (!given) {
@@ -406,8 +421,8 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // --- Seeds. --------------------------------------------------------------
   std::vector<Vec3> region_points(in.region_seeds.size());
   for (size_t i = 0; i < in.region_seeds.size(); ++i) region_points[i] = in.region_seeds[i].point;
-  const auto region_hits = LocatePoints(in.positions, in.tets, region_points, nbr4);
-  const auto hole_hits = LocatePoints(in.positions, in.tets, in.hole_seeds, nbr4);
+  const auto region_hits = LocatePoints(in.positions, tets, region_points, nbr4);
+  const auto hole_hits = LocatePoints(in.positions, tets, in.hole_seeds, nbr4);
 
   // A seed on a constrained face (or edge/vertex of one) touches tets of
   // several components: the tie rule picks one; say so.
@@ -430,7 +445,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   out.hole_tet.assign(in.hole_seeds.size(), kNoTet);
   for (size_t i = 0; i < in.hole_seeds.size(); ++i) {
     const std::string what = absl::StrCat("hole seed ", i, " ", PointString(in.hole_seeds[i]));
-    const uint32_t t = ChooseTet(hole_hits[i], in.tets);
+    const uint32_t t = ChooseTet(hole_hits[i], tets);
     out.hole_tet[i] = t;
     if (t == kNoTet) {
       out.issues.push_back({LabelIssueKind::kHoleSeedOutsideMesh,
@@ -448,7 +463,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
     const plc::RegionSeed& seed = in.region_seeds[i];
     const std::string what = absl::StrCat("region seed ", i, " ", PointString(seed.point),
                                           " (attribute ", seed.attribute, ")");
-    const uint32_t t = ChooseTet(region_hits[i], in.tets);
+    const uint32_t t = ChooseTet(region_hits[i], tets);
     out.seed_tet[i] = t;
     if (t == kNoTet) {
       out.issues.push_back({LabelIssueKind::kSeedOutsideMesh,

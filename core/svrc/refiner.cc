@@ -18,6 +18,7 @@
 #include <tuple>
 
 #include "absl/cleanup/cleanup.h"
+#include "absl/functional/function_ref.h"
 #include "absl/strings/str_cat.h"
 #include "core/mesh/conformity.h"
 #include "core/mesh/stats_payload.h"
@@ -458,8 +459,9 @@ class Refiner {
   absl::StatusOr<uint32_t> InsertSizePoints();
   // Stars and books of the stitched mesh above their region's volume bound
   // (normalised): a point of S for each, into stitch_failures_.
-  void CollectOversizedDelaunayTets(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets,
-                                   size_t count, const Labelling& lab, std::span<const double> comp_volume);
+  void CollectOversizedDelaunayTets(std::span<const Vec3> positions,
+                                   absl::FunctionRef<std::array<uint32_t, 4>(size_t)> tet_at, size_t count,
+                                   const Labelling& lab, std::span<const double> comp_volume);
   void QueueOversizedStitchRepairs(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets,
                                    const Labelling& lab, std::span<const double> comp_volume);
   // Consecutive collared points along each crease segment's M_s, in order:
@@ -3554,10 +3556,12 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const bool released = options_.release_label_caches && omega_.ReleaseCaches(options_.release_cache_min_bytes);
   const delaunay::Delaunay3& dt = omega_.dt();
   const uint32_t nv = dt.NumVertices();
-  std::vector<Vec3> positions(nv);
-  for (uint32_t v = 0; v < nv; ++v) positions[v] = dt.Point(VertexId(v));
-  std::vector<std::array<uint32_t, 4>> tets;
-  std::vector<TetId> tet_ids;  // M_Ω's tets, when `tets` are they
+  // M_Ω's points and (below) tets are read in place: their copies, 24 bytes
+  // per vertex and 16 per tet, were the peak of cube 1e-4 once the
+  // circumcentre cache was halved (session 47/48).
+  const std::span<const Vec3> positions = dt.Points();
+  std::vector<std::array<uint32_t, 4>> tets;  // the stitched mesh's (collars)
+  std::vector<TetId> tet_ids;  // else M_Ω's tets
   std::vector<ConstrainedFace> faces;
   if (stitched_done_) {
     // After RipStitchCollar (collars): label the stitched mesh, whose facets
@@ -3577,11 +3581,6 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     }
   } else {
     tet_ids = dt.FiniteTets();
-    tets.reserve(tet_ids.size());  // exact: doubling left up to 2x (the heap's peak is here)
-    for (TetId t : tet_ids) {
-      tets.push_back({dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
-                      dt.TetVertex(t, 3).value()});
-    }
     for (uint32_t f = 0; f < facets_.size(); ++f) {
       for (const auto& tri : facets_[f].InFacetTriangles()) {
         ConstrainedFace cf;
@@ -3612,6 +3611,20 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // labelling's face table (§8 item 43; the same labelling).
   std::vector<uint32_t> compact;
   std::vector<TetId> star;
+  const auto omega_tet = [&](size_t i) -> std::array<uint32_t, 4> {
+    const TetId t = tet_ids[i];
+    return {dt.TetVertex(t, 0).value(), dt.TetVertex(t, 1).value(), dt.TetVertex(t, 2).value(),
+            dt.TetVertex(t, 3).value()};
+  };
+  std::vector<std::array<uint32_t, 4>> copied;  // M_Ω's tets without the adjacency option
+  if (!stitched_done_ && !tet_ids.empty() && options_.label_with_adjacency) {
+    in.tet_vertices_of = omega_tet;
+    in.num_tets = tet_ids.size();
+  } else if (!stitched_done_) {
+    copied.reserve(tet_ids.size());
+    for (size_t i = 0; i < tet_ids.size(); ++i) copied.push_back(omega_tet(i));
+    in.tets = copied;
+  }
   if (!tet_ids.empty() && options_.label_with_adjacency) {
     compact.assign(dt.TetCapacity(), kNoTet);
     for (uint32_t i = 0; i < tet_ids.size(); ++i) compact[tet_ids[i].value()] = i;
@@ -3644,6 +3657,10 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   }
   absl::StatusOr<Labelling> lab = LabelRegions(in);
   if (!lab.ok()) return lab.status();
+  const size_t num_tets = stitched_done_ ? tets.size() : tet_ids.size();
+  const auto tet_at = [&](size_t i) -> std::array<uint32_t, 4> {
+    return stitched_done_ ? tets[i] : omega_tet(i);
+  };
   // Volumes scale by 2^−3e into normalised coordinates (exact).
   const double scale3 = std::ldexp(1.0, -3 * norm_.exponent);
   if (size_target_.size() < nv) size_target_.resize(nv, HUGE_VAL);
@@ -3663,7 +3680,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const bool sizes_before = tet_sizes_;
   // Per tet of tet_ids: its label is the one it was tested with when made
   // (or at the last labelling), so EnqueueTetIfBad would find it good.
-  std::vector<uint8_t> unchanged(old_labels > 0 ? tets.size() : 0, 0);
+  std::vector<uint8_t> unchanged(old_labels > 0 ? num_tets : 0, 0);
   // Cells are sized on the output's tets from now on (item 33); the memos
   // of Size() drop.
   omega_.SetLabels(!tet_labels_.empty() && options_.size_kept_tets && !in.keep_bounding_box ? &tet_labels_ : nullptr);
@@ -3701,7 +3718,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   // A volume bound is tested per tet on the volume itself (tet_volumes).
   const bool bounded = !uniform || (first_volume >= 0 && first_volume != HUGE_VAL);
   if (tet_mode_ && !collar_tets_ && (!uniform || options_.tet_sizes || (options_.tet_volumes && bounded))) tet_sizes_ = true;
-  for (size_t t = 0; t < tets.size(); ++t) {
+  for (size_t t = 0; t < num_tets; ++t) {
     const uint32_t c = lab->tet_component[t];
     const bool kept = lab->components[c].kept;
     const double rt = comp_target[c];
@@ -3719,15 +3736,15 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     if (!kept) continue;
     if (comp_volume[c] == HUGE_VAL) continue;
     if (tet_sizes_) continue;
-    for (uint32_t v : tets[t]) {
+    for (uint32_t v : tet_at(t)) {
       if (rt < size_target_[v]) {
         size_target_[v] = rt;
         touched[v] = 1;
       }
     }
   }
-  CollectOversizedDelaunayTets(positions, tets, stitched_done_ ? stitch_report_.outside_tets : tets.size(), *lab,
-                               comp_volume);
+  const size_t delaunay_tets = stitched_done_ ? std::min<size_t>(stitch_report_.outside_tets, num_tets) : num_tets;
+  CollectOversizedDelaunayTets(positions, tet_at, delaunay_tets, *lab, comp_volume);
   if (stitched_done_) QueueOversizedStitchRepairs(positions, tets, *lab, comp_volume);
   if (relabel) {
     // The slots of dead and ghost tets hold no label (a stale one would pass
@@ -3745,7 +3762,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
     std::vector<uint32_t>().swap(compact);
     std::vector<ConstrainedFace>().swap(faces);
     std::vector<std::array<uint32_t, 4>>().swap(tets);
-    std::vector<Vec3>().swap(positions);
+    std::vector<std::array<uint32_t, 4>>().swap(copied);
   }
   bool any = false;
   if (tet_mode_) {
@@ -3776,19 +3793,19 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
 // Tet t is in a kept component with a volume bound and its volume is
 // above it (normalised coordinates; 1e-9 relative slack downwards, so a
 // tet at the bound within rounding counts as above).
-bool KeptTetAboveBound(std::span<const Vec3> positions, std::span<const std::array<uint32_t, 4>> tets, size_t t,
+bool KeptTetAboveBound(std::span<const Vec3> positions, const std::array<uint32_t, 4>& q, size_t t,
                        const Labelling& lab, std::span<const double> comp_volume) {
   const uint32_t c = lab.tet_component[t];
   if (!lab.components[c].kept || comp_volume[c] == HUGE_VAL) return false;
-  const auto& q = tets[t];
   const Vec3 &a = positions[q[0]], &b = positions[q[1]], &cc = positions[q[2]], &d = positions[q[3]];
   const double vol = geom::Dot(b - a, geom::Cross(cc - a, d - a)) / 6;
   return vol > comp_volume[c] * (1 - 1e-9);
 }
 
 void Refiner::CollectOversizedDelaunayTets(std::span<const Vec3> positions,
-                                           std::span<const std::array<uint32_t, 4>> tets, size_t count,
-                                           const Labelling& lab, std::span<const double> comp_volume) {
+                                           absl::FunctionRef<std::array<uint32_t, 4>(size_t)> tet_at,
+                                           size_t count, const Labelling& lab,
+                                           std::span<const double> comp_volume) {
   // M_Ω's kept tets (the first `count` of `tets`) above their volume bound.
   // The cell test sizes a cell clipped by ∂Ω by its corners in Ω, so the
   // cell can look small while a tet at ∂Ω, its circumcentre outside Ω, is
@@ -3800,9 +3817,9 @@ void Refiner::CollectOversizedDelaunayTets(std::span<const Vec3> positions,
   // inserts them once the cell test finds nothing more.
   size_points_.clear();
   const geom::Box3& cube = omega_.cube();
-  for (size_t t = 0; t < count && t < tets.size(); ++t) {
-    if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
-    const auto& q = tets[t];
+  for (size_t t = 0; t < count; ++t) {
+    const std::array<uint32_t, 4> q = tet_at(t);
+    if (!KeptTetAboveBound(positions, q, t, lab, comp_volume)) continue;
     const Vec3 o = geom::TetCircumcenter(positions[q[0]], positions[q[1]], positions[q[2]], positions[q[3]]);
     Vec3 x = o;
     for (int k = 0; k < 3; ++k) x[k] = std::clamp(x[k], cube.lo[k], cube.hi[k]);
@@ -3848,7 +3865,7 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
     return NearestCirclePoint(circle, near, x) && on_s(*x, i, j);
   };
   for (size_t t = stitch_report_.outside_tets; t < tets.size(); ++t) {
-    if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
+    if (!KeptTetAboveBound(positions, tets[t], t, lab, comp_volume)) continue;
     const auto& q = tets[t];
     std::array<uint32_t, 2> centres{}, others{};
     int nc = 0, no = 0;
@@ -3895,7 +3912,7 @@ void Refiner::QueueOversizedStitchRepairs(std::span<const Vec3> positions,
   if (std::getenv("SVRC_COLLAR_DEBUG") != nullptr) {
     size_t over = 0, over_out = 0;
     for (size_t t = 0; t < tets.size(); ++t) {
-      if (!KeptTetAboveBound(positions, tets, t, lab, comp_volume)) continue;
+      if (!KeptTetAboveBound(positions, tets[t], t, lab, comp_volume)) continue;
       ++over;
       if (t < stitch_report_.outside_tets) ++over_out;
     }

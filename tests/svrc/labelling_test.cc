@@ -187,27 +187,41 @@ TEST(LabellingTest, GivenAdjacencyGivesTheSameLabelling) {
     auto it = slots_of.find(k);
     return it == slots_of.end() ? kNoTet : it->second.back();
   };
-  auto given = LabelRegions(in);
   auto table = LabelRegions(nb.Input(seeds, holes));
-  ASSERT_TRUE(given.ok()) << given.status();
   ASSERT_TRUE(table.ok()) << table.status();
-  EXPECT_EQ(given->tet_component, table->tet_component);
-  ASSERT_EQ(given->components.size(), table->components.size());
-  for (size_t c = 0; c < table->components.size(); ++c) {
-    EXPECT_EQ(given->components[c].first_tet, table->components[c].first_tet);
-    EXPECT_EQ(given->components[c].num_tets, table->components[c].num_tets);
-    EXPECT_EQ(given->components[c].kept, table->components[c].kept);
-    EXPECT_EQ(given->components[c].touches_box, table->components[c].touches_box);
-    EXPECT_EQ(given->components[c].seed, table->components[c].seed);
+  // The tets as an array, and read through tet_vertices_of (the refiner's
+  // M_Ω in place): the same labelling both ways.
+  LabelInput in_place = in;
+  in_place.tets = {};
+  in_place.tet_vertices_of = [&](uint32_t t) { return nb.grid.tets[t]; };
+  in_place.num_tets = nb.grid.tets.size();
+  for (const LabelInput* input : {&in, &in_place}) {
+    SCOPED_TRACE(input == &in ? "array" : "in place");
+    auto given = LabelRegions(*input);
+    ASSERT_TRUE(given.ok()) << given.status();
+    EXPECT_EQ(given->tet_component, table->tet_component);
+    ASSERT_EQ(given->components.size(), table->components.size());
+    for (size_t c = 0; c < table->components.size(); ++c) {
+      EXPECT_EQ(given->components[c].first_tet, table->components[c].first_tet);
+      EXPECT_EQ(given->components[c].num_tets, table->components[c].num_tets);
+      EXPECT_EQ(given->components[c].kept, table->components[c].kept);
+      EXPECT_EQ(given->components[c].touches_box, table->components[c].touches_box);
+      EXPECT_EQ(given->components[c].seed, table->components[c].seed);
+    }
+    EXPECT_EQ(given->seed_tet, table->seed_tet);
+    EXPECT_EQ(given->hole_tet, table->hole_tet);
+    EXPECT_EQ(given->num_kept_tets, table->num_kept_tets);
+    ASSERT_EQ(given->faces.size(), table->faces.size());
+    for (size_t i = 0; i < table->faces.size(); ++i) {
+      EXPECT_EQ(given->faces[i].tets, table->faces[i].tets) << i;
+      EXPECT_EQ(given->faces[i].constrained_face, table->faces[i].constrained_face) << i;
+    }
   }
-  EXPECT_EQ(given->seed_tet, table->seed_tet);
-  EXPECT_EQ(given->hole_tet, table->hole_tet);
-  EXPECT_EQ(given->num_kept_tets, table->num_kept_tets);
-  ASSERT_EQ(given->faces.size(), table->faces.size());
-  for (size_t i = 0; i < table->faces.size(); ++i) {
-    EXPECT_EQ(given->faces[i].tets, table->faces[i].tets) << i;
-    EXPECT_EQ(given->faces[i].constrained_face, table->faces[i].constrained_face) << i;
-  }
+  // tet_vertices_of reads no face table of its own: without the adjacency
+  // it is refused.
+  LabelInput no_adjacency = in_place;
+  no_adjacency.neighbor_slots_of = nullptr;
+  EXPECT_EQ(LabelRegions(no_adjacency).status().code(), absl::StatusCode::kInvalidArgument);
   // A constrained face that is no face of the tets is still an error.
   std::vector<ConstrainedFace> bad = nb.faces;
   bad.push_back({{0, 1, nb.grid.Id(8, 8, 8)}, 9, 0});
