@@ -590,8 +590,9 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   const bool dumping = dump_env != nullptr && *dump_env != '\0';
   std::vector<std::array<uint32_t, 4>> tets_before_flips;
   if (dumping && use_collars) tets_before_flips = refined->tets;
-  absl::StatusOr<refine::SliverResult> flipped = refine::RemoveSlivers(
-      refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver);
+  absl::StatusOr<refine::SliverResult> flipped =
+      refine::RemoveSlivers(refined->normalised_positions, refined->tets, faces, refined->segment_chains, sliver,
+                            refined->tet_neighbors.size() == refined->tets.size() ? &refined->tet_neighbors : nullptr);
   if (!flipped.ok()) return flipped.status();
   flipped->stats.ExportTo(&stats);
   refined->tets = std::move(flipped->tets);

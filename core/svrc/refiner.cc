@@ -4397,12 +4397,33 @@ PointSetRefinement Refiner::Output(std::span<const Vec3> input) {
   } else {
     const bool labelled = !tet_labels_.empty();
     const std::vector<TetId> finite = dt.FiniteTets();
-    out.tets.reserve(finite.size());
+    out.tets.resize(finite.size());
+    // With the adjacency in the same order (the index of a slot in `finite`;
+    // ghosts are the hull).
+    out.tet_neighbors.resize(finite.size());
     if (labelled) out.tet_outside.reserve(finite.size());
-    for (TetId t : finite) {
-      std::array<uint32_t, 4> tet;
-      for (int k = 0; k < 4; ++k) tet[k] = omega_.PointOf(dt.TetVertex(t, k)).value();
-      out.tets.push_back(tet);
+    // `finite` is in slot order, so a slot's index is its rank among the
+    // finite slots: a bit per slot and a count per 64 (cube 1e-6: 0.36 MB,
+    // in cache) instead of an index per slot (7.6 MB read at random, +0.1 s).
+    std::vector<uint64_t> is_finite((size_t{dt.TetCapacity()} + 63) / 64, 0);
+    for (const TetId t : finite) is_finite[t.value() >> 6] |= uint64_t{1} << (t.value() & 63);
+    std::vector<uint32_t> finite_before(is_finite.size());
+    for (uint32_t w = 0, count = 0; w < is_finite.size(); ++w) {
+      finite_before[w] = count;
+      count += static_cast<uint32_t>(std::popcount(is_finite[w]));
+    }
+    for (uint32_t i = 0; i < finite.size(); ++i) {
+      const TetId t = finite[i];
+      for (int k = 0; k < 4; ++k) {
+        out.tets[i][k] = omega_.PointOf(dt.TetVertex(t, k)).value();
+        // A finite tet's neighbour is alive: a ghost unless its bit is set
+        // (dt.IsGhost would read the neighbour's row, a cache miss each).
+        const uint32_t s = dt.Neighbor(t, k).value();
+        const uint64_t word = is_finite[s >> 6], bit = uint64_t{1} << (s & 63);
+        out.tet_neighbors[i][k] =
+            (word & bit) == 0 ? 0xFFFFFFFFu
+                              : finite_before[s >> 6] + static_cast<uint32_t>(std::popcount(word & (bit - 1)));
+      }
       if (labelled) {
         const TetLabel* lab = LiveLabel(t);
         out.tet_outside.push_back(lab != nullptr && !lab->kept() ? 1 : 0);

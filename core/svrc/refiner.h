@@ -489,6 +489,12 @@ struct PointSetRefinement {
   // and not stitched): 1 = known to lie outside the output (exterior or
   // hole). SliverOptions::skip_tet.
   std::vector<uint8_t> tet_outside;
+  // Per tet of `tets` (empty after the collar stitch): the index in `tets` of
+  // the tet across face f (the face opposite vertex f), 0xFFFFFFFF on M_Ω's
+  // hull — Delaunay3's adjacency, which the sliver pass takes instead of
+  // building a face table (SliverInput::neighbors; docs/svrc-design.md §8
+  // item 80).
+  std::vector<std::array<uint32_t, 4>> tet_neighbors;
   // Per input point: the position index of the mesh vertex it became (itself,
   // or an earlier point with identical coordinates).
   std::vector<uint32_t> input_vertex;

@@ -320,7 +320,7 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   const size_t num_tets = in.tets.size();
   if (num_tets >= kNone / 8) return absl::InvalidArgumentError("sliver: too many tets");
   tet_.assign(in.tets.begin(), in.tets.end());
-  nbr_.assign(num_tets, {kNone, kNone, kNone, kNone});
+  if (in.neighbors == nullptr) nbr_.assign(num_tets, {kNone, kNone, kNone, kNone});
   quality_.resize(num_tets);
   version_.assign(num_tets, 0);
   // Lazy angles need 0 < target < 90° (sin is increasing there).
@@ -351,8 +351,29 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // of a volume-bound run). Same pairs and the same error (the smallest face
   // in > 2 tets) as sorting all records by (key, tet, face). Kept until the
   // constrained faces are marked below.
-  std::optional<TetFaces> tet_faces(std::in_place, std::span<const Tet>(tet_), n);
-  {
+  // A mesher's own adjacency (SliverInput::neighbors) replaces the table:
+  // ids in range, and the constrained faces found in the stars of their
+  // smallest vertices (the same (tet, face) records as the table's buckets).
+  std::optional<TetFaces> tet_faces;
+  if (in.neighbors != nullptr) {
+    if (in.neighbors->size() != num_tets) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("sliver: ", in.neighbors->size(), " neighbour rows for ", num_tets, " tets"));
+    }
+    nbr_ = std::move(*in.neighbors);
+    in.neighbors->clear();
+    // In range; the rest is trusted (a symmetry check reading each
+    // neighbour's row cost as much as the table saved at cube 1e-6).
+    for (uint32_t t = 0; t < num_tets; ++t) {
+      for (int f = 0; f < 4; ++f) {
+        const uint32_t m = nbr_[t][f];
+        if (m != kNone && (m >= num_tets || m == t)) {
+          return absl::InvalidArgumentError(absl::StrCat("sliver: tet ", t, " face ", f, " has neighbour ", m));
+        }
+      }
+    }
+  } else {
+    tet_faces.emplace(std::span<const Tet>(tet_), n);
     TetFaces::Overused bad;
     if (!tet_faces->Match(
             [&](uint32_t s, uint32_t t) {
@@ -393,24 +414,67 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // in this pass's constraint lookups when stopped after 9 minutes).
   std::vector<uint8_t> constrained(num_tets, 0);
   auto mark = [&](const TetFace& f) { constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4)); };
+  // Without the table: the tets at each constraint's smallest vertex (CSR,
+  // as CheckConstraints builds them), their faces there with that vertex
+  // smallest standing in for its bucket.
+  std::vector<uint32_t> star_start, star;
+  if (!tet_faces && !cfaces_.empty()) {
+    std::vector<uint8_t> needed(n, 0);
+    for (const Tri& f : cfaces_) needed[f[0]] = 1;
+    star_start.assign(n + 1, 0);
+    for (const Tet& v : tet_) {
+      for (uint32_t x : v) star_start[x + 1] += needed[x];
+    }
+    for (size_t v = 0; v < n; ++v) star_start[v + 1] += star_start[v];
+    star.resize(star_start.back());
+    std::vector<uint32_t> fill(star_start.begin(), star_start.end() - 1);
+    for (uint32_t t = 0; t < num_tets; ++t) {
+      for (uint32_t x : tet_[t]) {
+        if (needed[x]) star[fill[x]++] = t;
+      }
+    }
+  }
+  std::vector<TetFace> bucket;
+  auto bucket_of = [&](uint32_t a) -> std::span<const TetFace> {
+    if (tet_faces) return tet_faces->Bucket(a);
+    bucket.clear();
+    for (uint32_t k = star_start[a]; k < star_start[a + 1]; ++k) {
+      const uint32_t t = star[k];
+      const Tet& v = tet_[t];
+      for (uint32_t f = 0; f < 4; ++f) {
+        if (v[f] == a) continue;  // the face opposite f holds a unless v[f] is a
+        std::array<uint32_t, 3> x;
+        for (uint32_t g = 0, m = 0; g < 4; ++g) {
+          if (g != f) x[m++] = v[g];
+        }
+        std::sort(x.begin(), x.end());
+        if (x[0] == a) bucket.push_back({x[1], x[2], 4 * t + f});
+      }
+    }
+    return bucket;
+  };
   for (size_t i = 0; i < cfaces_.size();) {
     const uint32_t a = cfaces_[i][0];
     size_t j = i;
     while (j < cfaces_.size() && cfaces_[j][0] == a) ++j;
+    const std::span<const TetFace> faces_at_a = bucket_of(a);
     if (j - i <= kConstraintScanRun) {
       for (size_t r = i; r < j; ++r) {
-        for (const TetFace& f : tet_faces->Bucket(a)) {
+        for (const TetFace& f : faces_at_a) {
           if (f.b == cfaces_[r][1] && f.c == cfaces_[r][2]) mark(f);
         }
       }
     } else {
-      for (const TetFace& f : tet_faces->Bucket(a)) {
+      for (const TetFace& f : faces_at_a) {
         if (std::binary_search(cfaces_.begin() + i, cfaces_.begin() + j, Tri{a, f.b, f.c})) mark(f);
       }
     }
     i = j;
   }
   tet_faces.reset();
+  std::vector<uint32_t>().swap(star);
+  std::vector<uint32_t>().swap(star_start);
+  std::vector<TetFace>().swap(bucket);
   absl::Status s = CheckConstraints();
   if (!s.ok()) return s;
   // Components: flood fill across non-constrained faces, in tet order.
@@ -1272,7 +1336,8 @@ absl::StatusOr<SliverResult> RemoveSlivers(std::span<const geom::Vec3> positions
                                            std::span<const std::array<uint32_t, 4>> tets,
                                            std::span<const ConstrainedFace> faces,
                                            std::span<const std::vector<uint32_t>> segment_chains,
-                                           const SliverOptions& options) {
+                                           const SliverOptions& options,
+                                           std::vector<std::array<uint32_t, 4>>* neighbors) {
   std::vector<Tri> cfaces;
   cfaces.reserve(faces.size());
   for (const ConstrainedFace& f : faces) cfaces.push_back(f.v);
@@ -1285,6 +1350,7 @@ absl::StatusOr<SliverResult> RemoveSlivers(std::span<const geom::Vec3> positions
   in.tets = tets;
   in.constrained_faces = cfaces;
   in.constrained_edges = cedges;
+  in.neighbors = neighbors;
   return RemoveSlivers(in, options);
 }
 

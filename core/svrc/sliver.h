@@ -145,6 +145,13 @@ struct SliverInput {
   // `tets`.
   std::span<const std::array<uint32_t, 3>> constrained_faces;
   std::span<const std::array<uint32_t, 2>> constrained_edges;
+  // Optional (null: built from the tets): per tet, the tet across face f
+  // (the face opposite vertex f), 0xFFFFFFFF where none — a mesher's own
+  // adjacency (PointSetRefinement::tet_neighbors). Moved from; trusted (only
+  // the ids' range is checked). The face table it
+  // replaces was 12% of the pass's instructions and 48 bytes per tet of fresh
+  // memory (docs/svrc-design.md §8 item 80).
+  std::vector<std::array<uint32_t, 4>>* neighbors = nullptr;
 };
 
 struct SliverResult {
@@ -185,6 +192,7 @@ absl::StatusOr<SliverResult> RemoveSlivers(std::span<const geom::Vec3> positions
                                            std::span<const std::array<uint32_t, 4>> tets,
                                            std::span<const ConstrainedFace> faces,
                                            std::span<const std::vector<uint32_t>> segment_chains,
-                                           const SliverOptions& options);
+                                           const SliverOptions& options,
+                                           std::vector<std::array<uint32_t, 4>>* neighbors = nullptr);
 
 }  // namespace svrc::refine

@@ -394,6 +394,82 @@ std::array<PointSetRefinement, 2> RefineTwiceAndCompare(const SameRefinementCase
 // shown to matter by these inputs: a stale Encroached event no longer
 // clears the flag of the ball now in its record, and a dead ball still
 // linked somewhere would not be recycled (no such ball was seen).
+// PointSetRefinement::tet_neighbors is M_Ω's adjacency in the order of
+// `tets` (each face shared with the tet it names, hull faces on no other
+// tet), and the sliver pass given it (SliverInput::neighbors, instead of
+// building its face table) makes the same flips: the same tets in the same
+// order and the same counts (docs/svrc-design.md §8 item 80).
+TEST(CollarRefine, RefinersAdjacencyGivesTheSameSliverPass) {
+  for (const auto& [rel, max_volume] : std::vector<std::pair<const char*, double>>{
+           {"a_convex/cube.poly", 1e-4}, {"b_internal/box_internal_facet.poly", 1e-4}, {"b_internal/box_in_box.poly", 0}}) {
+    absl::StatusOr<plc::Plc> plc = plc::ReadPlcFile(testing::CorpusPath(rel));
+    ASSERT_TRUE(plc.ok()) << rel << ": " << plc.status();
+    absl::StatusOr<plc::FeatureComplex> cx = plc::BuildFeatureComplex(*plc);
+    ASSERT_TRUE(cx.ok()) << cx.status();
+    RefineOptions opt;
+    opt.max_volume = max_volume;
+    absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
+    ASSERT_TRUE(run.ok()) << rel << ": " << run.status();
+    ASSERT_EQ(run->tet_neighbors.size(), run->tets.size()) << rel;
+    // Each face of each tet: the same three vertices in the tet named, which
+    // names it back; faces named by no tet are on exactly one tet.
+    std::map<std::array<uint32_t, 3>, int> face_count;
+    size_t hull = 0;
+    for (uint32_t t = 0; t < run->tets.size(); ++t) {
+      for (int f = 0; f < 4; ++f) {
+        std::array<uint32_t, 3> k;
+        for (int j = 0, m = 0; j < 4; ++j) {
+          if (j != f) k[m++] = run->tets[t][j];
+        }
+        std::sort(k.begin(), k.end());
+        ++face_count[k];
+        const uint32_t n = run->tet_neighbors[t][f];
+        if (n == 0xFFFFFFFFu) {
+          ++hull;
+          continue;
+        }
+        ASSERT_LT(n, run->tets.size());
+        int shared = 0;
+        for (uint32_t v : run->tets[n]) shared += std::binary_search(k.begin(), k.end(), v);
+        EXPECT_EQ(shared, 3) << rel << " tet " << t << " face " << f;
+        const auto& back = run->tet_neighbors[n];
+        EXPECT_TRUE(back[0] == t || back[1] == t || back[2] == t || back[3] == t) << rel << " tet " << t;
+      }
+    }
+    size_t single = 0;
+    for (const auto& [k, c] : face_count) {
+      ASSERT_LE(c, 2);
+      single += c == 1;
+    }
+    EXPECT_EQ(hull, single) << rel;
+    EXPECT_GT(hull, 0u) << rel;
+    const std::vector<ConstrainedFace> faces = ConstrainedFacesOf(*run, *cx);
+    SliverOptions so;
+    so.skip_tet = run->tet_outside;
+    so.keep_max_volume = max_volume > 0;
+    absl::StatusOr<SliverResult> table = RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so);
+    std::vector<std::array<uint32_t, 4>> nbr = run->tet_neighbors;
+    absl::StatusOr<SliverResult> given =
+        RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so, &nbr);
+    ASSERT_TRUE(table.ok()) << rel << ": " << table.status();
+    ASSERT_TRUE(given.ok()) << rel << ": " << given.status();
+    EXPECT_GT(table->stats.flips(), 0u) << rel;
+    EXPECT_EQ(given->tets, table->tets) << rel;
+    EXPECT_EQ(given->stats.flips(), table->stats.flips()) << rel;
+    EXPECT_EQ(given->stats.candidates, table->stats.candidates) << rel;
+    EXPECT_EQ(given->stats.bad_after, table->stats.bad_after) << rel;
+    // A neighbour id out of range, or a row count that is not the tets', is refused.
+    nbr = run->tet_neighbors;
+    nbr[0][0] = static_cast<uint32_t>(run->tets.size());
+    EXPECT_EQ(RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so, &nbr).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    nbr = run->tet_neighbors;
+    nbr.pop_back();
+    EXPECT_EQ(RemoveSlivers(run->normalised_positions, run->tets, faces, run->segment_chains, so, &nbr).status().code(),
+              absl::StatusCode::kInvalidArgument);
+  }
+}
+
 TEST(CollarRefine, RecycledBallRecordsGiveTheSameRefinementInHalfTheRecords) {
   if (kSanitized) GTEST_SKIP() << "release only";
   struct Case {
