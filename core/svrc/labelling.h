@@ -39,7 +39,7 @@ struct LabelInput {
   // Or, with neighbor_slots_of and find_face below, `num_tets` tets whose
   // vertices this function gives (tets then empty): the refiner's M_Ω is
   // read in place instead of copied (16 bytes per tet, the peak of a small
-  // run's labelling; session 47).
+  // run's labelling; docs/svrc-design.md §8 item 79).
   std::function<std::array<uint32_t, 4>(uint32_t)> tet_vertices_of;
   size_t num_tets = 0;
   std::span<const ConstrainedFace> constrained_faces;

@@ -3558,7 +3558,7 @@ absl::StatusOr<bool> Refiner::SetSizeTargets(const plc::FeatureComplex& complex,
   const uint32_t nv = dt.NumVertices();
   // M_Ω's points and (below) tets are read in place: their copies, 24 bytes
   // per vertex and 16 per tet, were the peak of cube 1e-4 once the
-  // circumcentre cache was halved (session 47/48).
+  // circumcentre cache was halved (docs/svrc-design.md §8 item 79).
   const std::span<const Vec3> positions = dt.Points();
   std::vector<std::array<uint32_t, 4>> tets;  // the stitched mesh's (collars)
   std::vector<TetId> tet_ids;  // else M_Ω's tets
