@@ -25,19 +25,38 @@ void SortCarrying(std::vector<std::array<uint32_t, N>>* items, std::vector<int32
     int32_t tag;
     uint32_t pos;
   };
-  std::vector<Record> rec(n);
-  for (size_t i = 0; i < n; ++i) {
-    const std::array<uint32_t, N>& t = (*items)[i];
-    const uint64_t hi = (uint64_t{t[0]} << 32) | t[1];
-    const uint64_t lo = (uint64_t{t[2]} << 32) | (N == 4 ? t[N - 1] : 0u);
-    rec[i] = {hi, lo, has_tags ? (*tags)[i] : 0, static_cast<uint32_t>(i)};
-  }
-  std::sort(rec.begin(), rec.end(), [](const Record& a, const Record& b) {
+  const auto less = [](const Record& a, const Record& b) {
     if (a.hi != b.hi) return a.hi < b.hi;
     if (a.lo != b.lo) return a.lo < b.lo;
     if (a.tag != b.tag) return a.tag < b.tag;
     return a.pos < b.pos;
-  });
+  };
+  auto record = [&](size_t i) {
+    const std::array<uint32_t, N>& t = (*items)[i];
+    const uint64_t hi = (uint64_t{t[0]} << 32) | t[1];
+    const uint64_t lo = (uint64_t{t[2]} << 32) | (N == 4 ? t[N - 1] : 0u);
+    return Record{hi, lo, has_tags ? (*tags)[i] : 0, static_cast<uint32_t>(i)};
+  };
+  uint32_t max_first = 0;
+  for (const auto& t : *items) max_first = std::max(max_first, t[0]);
+  std::vector<Record> rec(n);
+  if (max_first <= 4 * n + 1024) {
+    // Bucketed by the first id (a counting sort), each bucket then sorted:
+    // the order is the comparator's total order (the position breaks every
+    // tie), as one std::sort of all records gave, which was 44% of the
+    // output stage's instructions at cube --max-volume 1e-5 (n log n).
+    std::vector<uint32_t> start(size_t{max_first} + 2, 0);
+    for (const auto& t : *items) ++start[size_t{t[0]} + 1];
+    for (size_t a = 0; a <= max_first; ++a) start[a + 1] += start[a];
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < n; ++i) rec[fill[(*items)[i][0]]++] = record(i);
+    for (size_t a = 0; a <= max_first; ++a) {
+      if (start[a + 1] - start[a] > 1) std::sort(rec.begin() + start[a], rec.begin() + start[a + 1], less);
+    }
+  } else {
+    for (size_t i = 0; i < n; ++i) rec[i] = record(i);
+    std::sort(rec.begin(), rec.end(), less);
+  }
   std::vector<std::array<uint32_t, N>> sorted(n);
   for (size_t k = 0; k < n; ++k) sorted[k] = (*items)[rec[k].pos];
   *items = std::move(sorted);

@@ -158,41 +158,48 @@ TEST(Canonicalize, EmptyTagArraysAreAllowed) {
 // then tag (signed), then the original position. Ids above 2^31 (the sign
 // bit of a packed word), repeated items with different and equal tags,
 // negative tags, triangles and tets.
+// Both sort paths: ids up to 2^31 (one sort of all records) and dense ids
+// below the item count (bucketed by the first id, then sorted per bucket),
+// each with repeated items and tags.
 TEST(Canonicalize, OrderIsItemThenTagThenPosition) {
-  std::mt19937 rng(15);
-  auto id = [&] {
-    const uint32_t small = rng() % 6;
-    return rng() % 3 == 0 ? 0x80000000u + small : small;
-  };
-  TetMesh m;
-  for (int i = 0; i < 3000; ++i) {
-    m.tets.push_back(CanonicalTet({id(), id(), id(), id()}));
-    m.tet_region.push_back(static_cast<int32_t>(rng() % 5) - 2);
-    m.triangles.push_back(CanonicalTriangle({id(), id(), id()}));
-    m.triangle_marker.push_back(static_cast<int32_t>(rng() % 5) - 2);
-  }
-  auto reference = [](auto items, std::vector<int32_t> tags) {
-    std::vector<size_t> perm(items.size());
-    for (size_t i = 0; i < perm.size(); ++i) perm[i] = i;
-    std::stable_sort(perm.begin(), perm.end(), [&](size_t a, size_t b) {
-      if (items[a] != items[b]) return items[a] < items[b];
-      return tags[a] < tags[b];
-    });
-    decltype(items) out_items;
-    std::vector<int32_t> out_tags;
-    for (size_t k : perm) {
-      out_items.push_back(items[k]);
-      out_tags.push_back(tags[k]);
+  for (const bool sparse : {true, false}) {
+    SCOPED_TRACE(sparse ? "sparse ids" : "dense ids");
+    std::mt19937 rng(15);
+    auto id = [&] {
+      if (!sparse) return static_cast<uint32_t>(rng() % 40);
+      const uint32_t small = rng() % 6;
+      return rng() % 3 == 0 ? 0x80000000u + small : small;
+    };
+    TetMesh m;
+    for (int i = 0; i < 3000; ++i) {
+      m.tets.push_back(CanonicalTet({id(), id(), id(), id()}));
+      m.tet_region.push_back(static_cast<int32_t>(rng() % 5) - 2);
+      m.triangles.push_back(CanonicalTriangle({id(), id(), id()}));
+      m.triangle_marker.push_back(static_cast<int32_t>(rng() % 5) - 2);
     }
-    return std::make_pair(out_items, out_tags);
-  };
-  const auto tets = reference(m.tets, m.tet_region);
-  const auto tris = reference(m.triangles, m.triangle_marker);
-  Canonicalize(&m);
-  EXPECT_EQ(m.tets, tets.first);
-  EXPECT_EQ(m.tet_region, tets.second);
-  EXPECT_EQ(m.triangles, tris.first);
-  EXPECT_EQ(m.triangle_marker, tris.second);
+    auto reference = [](auto items, std::vector<int32_t> tags) {
+      std::vector<size_t> perm(items.size());
+      for (size_t i = 0; i < perm.size(); ++i) perm[i] = i;
+      std::stable_sort(perm.begin(), perm.end(), [&](size_t a, size_t b) {
+        if (items[a] != items[b]) return items[a] < items[b];
+        return tags[a] < tags[b];
+      });
+      decltype(items) out_items;
+      std::vector<int32_t> out_tags;
+      for (size_t k : perm) {
+        out_items.push_back(items[k]);
+        out_tags.push_back(tags[k]);
+      }
+      return std::make_pair(out_items, out_tags);
+    };
+    const auto tets = reference(m.tets, m.tet_region);
+    const auto tris = reference(m.triangles, m.triangle_marker);
+    Canonicalize(&m);
+    EXPECT_EQ(m.tets, tets.first);
+    EXPECT_EQ(m.tet_region, tets.second);
+    EXPECT_EQ(m.triangles, tris.first);
+    EXPECT_EQ(m.triangle_marker, tris.second);
+  }
 }
 
 TEST(SpatialOrder, IsAPermutationAndDeterministic) {
