@@ -430,6 +430,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   options.theta = params.theta;
   options.max_vertices = params.max_vertices;
   options.max_volume = params.max_volume;
+  options.output_tet_neighbors = true;  // for the sliver pass (below)
   if (params.min_dihedral > 0) {
     // Sliver removal to a target (thesis §6.2.1; docs/svrc-design.md §8
     // item 69): the sliver rounds break every kept tet below it, at the best

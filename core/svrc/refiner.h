@@ -120,6 +120,11 @@ struct RefineOptions {
   // the labelling's face table (§8 item 43; the same labelling); false: the
   // table (tests).
   bool label_with_adjacency = true;
+  // Output PointSetRefinement::tet_neighbors (M_Ω's adjacency for the sliver
+  // pass, §8 item 80): core::MeshPlc asks for it; it costs RefinePlc 0.6% /
+  // 0.9% of its instructions at cube 1e-4 / 1e-5, which a caller without
+  // the pass need not pay.
+  bool output_tet_neighbors = false;
   // M_Ω's circumcentre cache and Size() memos hold at most 2^omega_cc_log2
   // and 2^omega_memo_log2 records, direct-mapped (OmegaMesh::
   // SetCacheLimits; §8 item 44): memory a run would otherwise spend per tet
@@ -489,7 +494,8 @@ struct PointSetRefinement {
   // and not stitched): 1 = known to lie outside the output (exterior or
   // hole). SliverOptions::skip_tet.
   std::vector<uint8_t> tet_outside;
-  // Per tet of `tets` (empty after the collar stitch): the index in `tets` of
+  // Per tet of `tets` (empty unless RefineOptions::output_tet_neighbors, and
+  // after the collar stitch): the index in `tets` of
   // the tet across face f (the face opposite vertex f), 0xFFFFFFFF on M_Ω's
   // hull — Delaunay3's adjacency, which the sliver pass takes instead of
   // building a face table (SliverInput::neighbors; docs/svrc-design.md §8

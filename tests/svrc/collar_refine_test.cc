@@ -408,6 +408,7 @@ TEST(CollarRefine, RefinersAdjacencyGivesTheSameSliverPass) {
     ASSERT_TRUE(cx.ok()) << cx.status();
     RefineOptions opt;
     opt.max_volume = max_volume;
+    opt.output_tet_neighbors = true;
     absl::StatusOr<PointSetRefinement> run = RefinePlc(*cx, opt);
     ASSERT_TRUE(run.ok()) << rel << ": " << run.status();
     ASSERT_EQ(run->tet_neighbors.size(), run->tets.size()) << rel;
