@@ -218,6 +218,15 @@ class FlipMesh {
   void Summarize(bool before);
 
  private:
+  // Vertex -> live tets (CSR: the tets at v are star[start[v] .. start[v+1])),
+  // for the first vertices of the constraints only (the scatter of all 4T
+  // incidences was most of the cost; boundary vertices are a fraction of all).
+  struct ConstraintStars {
+    std::vector<uint32_t> start, star;
+  };
+  ConstraintStars BuildConstraintStars() const;
+  // CheckConstraints on stars already built for the current tets.
+  absl::Status CheckConstraints(const ConstraintStars& stars) const;
   bool FaceConstrained(const Tri& f) const {
     return std::binary_search(cfaces_.begin(), cfaces_.end(), f);
   }
@@ -414,32 +423,19 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // in this pass's constraint lookups when stopped after 9 minutes).
   std::vector<uint8_t> constrained(num_tets, 0);
   auto mark = [&](const TetFace& f) { constrained[f.slot / 4] |= static_cast<uint8_t>(1u << (f.slot % 4)); };
-  // Without the table: the tets at each constraint's smallest vertex (CSR,
-  // as CheckConstraints builds them), their faces there with that vertex
-  // smallest standing in for its bucket.
-  std::vector<uint32_t> star_start, star;
-  if (!tet_faces && !cfaces_.empty()) {
-    std::vector<uint8_t> needed(n, 0);
-    for (const Tri& f : cfaces_) needed[f[0]] = 1;
-    star_start.assign(n + 1, 0);
-    for (const Tet& v : tet_) {
-      for (uint32_t x : v) star_start[x + 1] += needed[x];
-    }
-    for (size_t v = 0; v < n; ++v) star_start[v + 1] += star_start[v];
-    star.resize(star_start.back());
-    std::vector<uint32_t> fill(star_start.begin(), star_start.end() - 1);
-    for (uint32_t t = 0; t < num_tets; ++t) {
-      for (uint32_t x : tet_[t]) {
-        if (needed[x]) star[fill[x]++] = t;
-      }
-    }
-  }
+  // The stars of the constraints' first vertices, built once for both uses:
+  // without the table, a's faces there with a smallest stand in for its
+  // bucket; CheckConstraints reads them (with the table, built after it is
+  // freed).
+  const bool table = tet_faces.has_value();
+  ConstraintStars stars;
+  if (!table) stars = BuildConstraintStars();
   std::vector<TetFace> bucket;
   auto bucket_of = [&](uint32_t a) -> std::span<const TetFace> {
-    if (tet_faces) return tet_faces->Bucket(a);
+    if (table) return tet_faces->Bucket(a);
     bucket.clear();
-    for (uint32_t k = star_start[a]; k < star_start[a + 1]; ++k) {
-      const uint32_t t = star[k];
+    for (uint32_t k = stars.start[a]; k < stars.start[a + 1]; ++k) {
+      const uint32_t t = stars.star[k];
       const Tet& v = tet_[t];
       for (uint32_t f = 0; f < 4; ++f) {
         if (v[f] == a) continue;  // the face opposite f holds a unless v[f] is a
@@ -472,11 +468,11 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
     i = j;
   }
   tet_faces.reset();
-  std::vector<uint32_t>().swap(star);
-  std::vector<uint32_t>().swap(star_start);
   std::vector<TetFace>().swap(bucket);
-  absl::Status s = CheckConstraints();
+  if (table) stars = BuildConstraintStars();
+  absl::Status s = CheckConstraints(stars);
   if (!s.ok()) return s;
+  stars = {};
   // Components: flood fill across non-constrained faces, in tet order.
   component_.assign(num_tets, kNone);
   std::vector<uint32_t> stack;
@@ -501,29 +497,38 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   return absl::OkStatus();
 }
 
-absl::Status FlipMesh::CheckConstraints() const {
-  // Vertex -> live tets (CSR); each constraint is looked up in the star of
-  // its first vertex. O(T + constraints · degree), no sort. Only the first
-  // vertices of constraints get a star (the scatter of all 4T incidences was
-  // most of the cost; boundary vertices are a fraction of all).
-  if (cfaces_.empty() && cedges_.empty()) return absl::OkStatus();
+FlipMesh::ConstraintStars FlipMesh::BuildConstraintStars() const {
+  ConstraintStars out;
+  if (cfaces_.empty() && cedges_.empty()) return out;
   std::vector<uint8_t> needed(pos_.size(), 0);
   for (const Tri& f : cfaces_) needed[f[0]] = 1;
   for (const Edge& e : cedges_) needed[e[0]] = 1;
-  std::vector<uint32_t> start(pos_.size() + 1, 0);
+  std::vector<uint32_t>& start = out.start;
+  start.assign(pos_.size() + 1, 0);
   for (size_t t = 0; t < tet_.size(); ++t) {
     if (!alive_[t]) continue;
     for (uint32_t v : tet_[t]) start[v + 1] += needed[v];
   }
   for (size_t v = 0; v < pos_.size(); ++v) start[v + 1] += start[v];
-  std::vector<uint32_t> star(start.back());
+  out.star.resize(start.back());
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
   for (size_t t = 0; t < tet_.size(); ++t) {
     if (!alive_[t]) continue;
     for (uint32_t v : tet_[t]) {
-      if (needed[v]) star[fill[v]++] = static_cast<uint32_t>(t);
+      if (needed[v]) out.star[fill[v]++] = static_cast<uint32_t>(t);
     }
   }
+  return out;
+}
+
+absl::Status FlipMesh::CheckConstraints() const { return CheckConstraints(BuildConstraintStars()); }
+
+absl::Status FlipMesh::CheckConstraints(const ConstraintStars& stars) const {
+  // Each constraint is looked up in the star of its first vertex.
+  // O(T + constraints · degree), no sort.
+  if (cfaces_.empty() && cedges_.empty()) return absl::OkStatus();
+  const std::vector<uint32_t>& start = stars.start;
+  const std::vector<uint32_t>& star = stars.star;
   // The constraints whose first vertex is a (sorted runs of cfaces_ and
   // cedges_) are each scanned for in a's star, or with more than
   // kConstraintScanRun of them the star is read once and the faces and edges
