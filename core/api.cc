@@ -586,6 +586,7 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   // Crease vertices on either path: a flip may relax the radius-edge bound
   // only for new tets touching a crease.
   if (!crease.empty()) sliver.crease_vertex = CreaseVerticesOf(*refined, *complex);
+  sliver.output_neighbors = true;
   // SVRC_DUMP_NONCONFORMING (debugging aid, below): the tets before the flips.
   const char* dump_env = std::getenv("SVRC_DUMP_NONCONFORMING");
   const bool dumping = dump_env != nullptr && *dump_env != '\0';
@@ -597,11 +598,15 @@ absl::StatusOr<mesh::TetMesh> MeshPlcSvrc(const plc::Plc& user_plc, const MeshPa
   if (!flipped.ok()) return flipped.status();
   flipped->stats.ExportTo(&stats);
   refined->tets = std::move(flipped->tets);
+  // The flips' final adjacency: the output labelling builds no face table
+  // (docs/svrc-design.md §8 item 82).
+  std::vector<std::array<uint32_t, 4>> neighbors = std::move(flipped->neighbors);
   // The refiner's exact normalisation x' = (x − t)·2^−e.
   const refine::CoordinateMap map = refine::CoordinateMapOf(*refined);
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex, faces, map,
-                              /*keep_bounding_box=*/false, &stats);
+                              /*keep_bounding_box=*/false, &stats, neighbors);
+  std::vector<std::array<uint32_t, 4>>().swap(neighbors);
   if (!out.ok()) {
     // The labelling says "no tetrahedron is left" (INVALID_ARGUMENT) for an
     // open surface or hole seeds that fill every region. Validation has

@@ -248,7 +248,8 @@ absl::StatusOr<OutputStageResult> BuildOutputMesh(const plc::Plc& plc,
                                                   std::span<const uint32_t> input_vertex,
                                                   std::span<const ConstrainedFace> constrained_faces,
                                                   const CoordinateMap& map, bool keep_bounding_box,
-                                                  const mesh::MeshStats* stats) {
+                                                  const mesh::MeshStats* stats,
+                                                  std::span<const std::array<uint32_t, 4>> neighbor_tets) {
   std::vector<plc::RegionSeed> seeds = plc.regions;
   for (plc::RegionSeed& s : seeds) s.point = map.ToMesher(s.point);
   std::vector<Vec3> holes(plc.holes.size());
@@ -261,6 +262,7 @@ absl::StatusOr<OutputStageResult> BuildOutputMesh(const plc::Plc& plc,
   li.region_seeds = seeds;
   li.hole_seeds = holes;
   li.keep_bounding_box = keep_bounding_box;
+  li.neighbor_tets = neighbor_tets;
   absl::StatusOr<Labelling> lab = LabelRegions(li);
   if (!lab.ok()) return lab.status();
 

@@ -80,6 +80,8 @@ absl::StatusOr<AssembledMesh> AssembleMesh(const AssembleInput& input);
 
 // The whole output stage in one call: maps the PLC's seeds with `map`, labels
 // (LabelRegions), assembles (AssembleMesh). Label issues are returned too.
+// `neighbor_tets` (optional, LabelInput::neighbor_tets): the tets'
+// adjacency, e.g. the sliver pass's; the labelling then builds no face table.
 struct OutputStageResult {
   mesh::TetMesh mesh;
   AssembleReport report;
@@ -91,6 +93,7 @@ absl::StatusOr<OutputStageResult> BuildOutputMesh(const plc::Plc& plc,
                                                   std::span<const uint32_t> input_vertex,
                                                   std::span<const ConstrainedFace> constrained_faces,
                                                   const CoordinateMap& map, bool keep_bounding_box,
-                                                  const mesh::MeshStats* stats = nullptr);
+                                                  const mesh::MeshStats* stats = nullptr,
+                                                  std::span<const std::array<uint32_t, 4>> neighbor_tets = {});
 
 }  // namespace svrc::refine

@@ -256,22 +256,96 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
   // of the labelling). Two records: the tets are neighbours; more: not a
   // tetrahedralization (reported for the smallest (a, b, c), with its three
   // smallest slots).
-  const bool given = in.neighbor_slots_of != nullptr && in.find_face != nullptr;
-  if (in.tet_vertices_of != nullptr && !given) {
+  const bool slot_array = !in.neighbor_tets.empty();
+  const bool given = slot_array || (in.neighbor_slots_of != nullptr && in.find_face != nullptr);
+  if (in.tet_vertices_of != nullptr && (slot_array || !given)) {
     return absl::InvalidArgumentError("tet_vertices_of needs neighbor_slots_of and find_face");
   }
+  if (slot_array) {
+    if (in.neighbor_tets.size() != nt) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(in.neighbor_tets.size(), " rows of neighbour tets for ", nt, " tets"));
+    }
+    for (size_t t = 0; t < nt; ++t) {
+      for (int f = 0; f < 4; ++f) {
+        const uint32_t u = in.neighbor_tets[t][f];
+        if (u != kNoTet && (u >= nt || u == t)) {
+          return absl::InvalidArgumentError(absl::StrCat("tet ", t, " face ", f, " has neighbour ", u));
+        }
+      }
+    }
+  }
+  // With the array: the tets at each constrained face's smallest vertex
+  // (CSR, ascending tet index), where the face is looked for.
+  std::vector<uint32_t> star_start, star_tet;
+  if (slot_array) {
+    std::vector<uint8_t> first(nv, 0);
+    for (const ConstrainedFace& cf : in.constrained_faces) {
+      first[std::min({cf.v[0], cf.v[1], cf.v[2]})] = 1;
+    }
+    star_start.assign(nv + 1, 0);
+    for (size_t t = 0; t < nt; ++t) {
+      for (uint32_t v : in.tets[t]) star_start[v + 1] += first[v];
+    }
+    for (size_t v = 0; v < nv; ++v) star_start[v + 1] += star_start[v];
+    star_tet.resize(star_start[nv]);
+    std::vector<uint32_t> fill(star_start.begin(), star_start.end() - 1);
+    for (size_t t = 0; t < nt; ++t) {
+      for (uint32_t v : in.tets[t]) {
+        if (first[v]) star_tet[fill[v]++] = static_cast<uint32_t>(t);
+      }
+    }
+  }
+  // Some slot of face {a, b, c} (a its smallest vertex), from the given
+  // function or the stars: the first tet at a holding b and c.
+  auto find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
+    if (!slot_array) return in.find_face(a, b, c);
+    for (uint32_t i = star_start[a]; i < star_start[a + 1]; ++i) {
+      const uint32_t t = star_tet[i];
+      const std::array<uint32_t, 4>& tv = in.tets[t];
+      int found = 0, other = -1;
+      for (int k = 0; k < 4; ++k) {
+        if (tv[k] == a || tv[k] == b || tv[k] == c) {
+          ++found;
+        } else {
+          other = k;
+        }
+      }
+      if (found == 3 && other >= 0) return 4 * t + static_cast<uint32_t>(other);
+    }
+    return kNoTet;
+  };
   std::optional<TetFaces> tet_faces;
   std::vector<uint32_t> own_nbr;
   if (!given) {
     tet_faces.emplace(in.tets, nv);
     own_nbr.assign(4 * nt, kNoTet);
   }
-  // The four slots facing tet t's (one call per tet when given).
+  // The four slots facing tet t's (one call per tet when given). From the
+  // array of neighbour tets: 4u, a slot of the right tet, which is all the
+  // flood and the walks read (slot / 4); nbr() below finds the exact one.
   auto nbr4 = [&](uint32_t t) -> std::array<uint32_t, 4> {
+    if (slot_array) {
+      const std::array<uint32_t, 4>& r = in.neighbor_tets[t];
+      return {r[0] == kNoTet ? kNoTet : 4 * r[0], r[1] == kNoTet ? kNoTet : 4 * r[1],
+              r[2] == kNoTet ? kNoTet : 4 * r[2], r[3] == kNoTet ? kNoTet : 4 * r[3]};
+    }
     if (given) return in.neighbor_slots_of(t);
     return {own_nbr[4 * t], own_nbr[4 * t + 1], own_nbr[4 * t + 2], own_nbr[4 * t + 3]};
   };
-  auto nbr = [&](uint32_t s) { return nbr4(s / 4)[s % 4]; };
+  // The slot across slot s: with the array, the face of the tet across
+  // that names s's tet back (kNoTet if none does: not an adjacency).
+  bool asymmetric = false;
+  auto nbr = [&](uint32_t s) -> uint32_t {
+    if (!slot_array) return nbr4(s / 4)[s % 4];
+    const uint32_t u = in.neighbor_tets[s / 4][s % 4];
+    if (u == kNoTet) return kNoTet;
+    for (uint32_t g = 0; g < 4; ++g) {
+      if (in.neighbor_tets[u][g] == s / 4) return 4 * u + g;
+    }
+    asymmetric = true;
+    return kNoTet;
+  };
   if (!given) {
     TetFaces::Overused bad;
     if (!tet_faces->Match(
@@ -361,7 +435,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       // the smaller of the given slot and its neighbour.
       uint32_t first_slot = kNoTet;
       if (given) {
-        const uint32_t s = in.find_face(k[0], k[1], k[2]);
+        const uint32_t s = find_face(k[0], k[1], k[2]);
         if (s != kNoTet) {
           const uint32_t other = nbr(s);
           first_slot = other != kNoTet ? std::min(s, other) : s;
@@ -381,6 +455,9 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
         mark_constrained(other);
       }
     }
+  }
+  if (asymmetric) {
+    return absl::InvalidArgumentError("the neighbour tets of a constrained face do not name it back");
   }
 
   // --- Flood fill across non-constrained faces. ----------------------------

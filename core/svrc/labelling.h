@@ -61,6 +61,14 @@ struct LabelInput {
   // 16 bytes per tet, was a fifth of the labelling's peak; session 29.)
   std::function<std::array<uint32_t, 4>(uint32_t)> neighbor_slots_of;
   std::function<uint32_t(uint32_t, uint32_t, uint32_t)> find_face;
+  // Or, instead of both functions, the adjacency as an array (with `tets`,
+  // not tet_vertices_of): per tet t, the tet across face f (opposite local
+  // vertex f), kNoTet on the boundary — the sliver pass's final adjacency
+  // (SliverResult::neighbors). The constrained faces are found in the stars
+  // of their smallest vertices, and their far sides by the tet across
+  // naming t back (else INVALID_ARGUMENT); ids are range-checked and the
+  // rest trusted. The same labelling (docs/svrc-design.md §8 item 82).
+  std::span<const std::array<uint32_t, 4>> neighbor_tets;
 };
 
 enum class LabelIssueKind {

@@ -215,6 +215,17 @@ class FlipMesh {
   void Run();
   absl::Status CheckConstraints() const;
   std::vector<Tet> Output() const;
+  // After the flips: the per-slot work arrays (qualities, versions,
+  // components) go before the outputs are built.
+  void ReleaseWorkArrays() {
+    std::vector<Quality>().swap(quality_);
+    std::vector<uint32_t>().swap(version_);
+    std::vector<uint32_t>().swap(component_);
+    std::vector<double>().swap(component_max_volume_);
+  }
+  // The adjacency of Output()'s tets, by their index there
+  // (SliverResult::neighbors).
+  std::vector<std::array<uint32_t, 4>> OutputNeighbors() const;
   void Summarize(bool before);
 
  private:
@@ -1208,6 +1219,25 @@ std::vector<Tet> FlipMesh::Output() const {
   return out;
 }
 
+std::vector<std::array<uint32_t, 4>> FlipMesh::OutputNeighbors() const {
+  // Output() keeps the live slots in slot order: a slot's index there is its
+  // rank among them (dead slots are named by no live tet).
+  std::vector<uint32_t> rank(tet_.size(), kNone);
+  uint32_t live = 0;
+  for (size_t t = 0; t < tet_.size(); ++t) {
+    if (alive_[t]) rank[t] = live++;
+  }
+  std::vector<std::array<uint32_t, 4>> out;
+  out.reserve(live);
+  for (size_t t = 0; t < tet_.size(); ++t) {
+    if (!alive_[t]) continue;
+    std::array<uint32_t, 4> row;
+    for (int f = 0; f < 4; ++f) row[f] = nbr_[t][f] == kNone ? kNone : rank[nbr_[t][f]];
+    out.push_back(row);
+  }
+  return out;
+}
+
 }  // namespace
 
 namespace {
@@ -1332,7 +1362,9 @@ absl::StatusOr<SliverResult> RemoveSlivers(const SliverInput& input, const Slive
   mesh.Summarize(/*before=*/false);
   s = mesh.CheckConstraints();
   if (!s.ok()) return absl::InternalError(absl::StrCat("sliver: after flipping: ", s.message()));
+  mesh.ReleaseWorkArrays();
   result.tets = mesh.Output();
+  if (options.output_neighbors) result.neighbors = mesh.OutputNeighbors();
   result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

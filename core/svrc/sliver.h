@@ -83,6 +83,10 @@ struct SliverOptions {
   // flip found so far). The chosen flips are the same (tested), with far
   // fewer tets measured. false: every triangle measured (the reference).
   bool prune_edge_removals = true;
+  // Also output the final adjacency (SliverResult::neighbors) for the
+  // output stage's labelling, which then builds no face table of its own
+  // (docs/svrc-design.md §8 item 82).
+  bool output_neighbors = false;
 };
 
 // The quality the pass ranks tets by: the smallest and largest dihedral
@@ -162,6 +166,11 @@ struct SliverResult {
   // constrained edge an edge. Surviving input tets keep their vertex order;
   // the order of the list is deterministic (slot order of the flip structure).
   std::vector<std::array<uint32_t, 4>> tets;
+  // With SliverOptions::output_neighbors: per tet of `tets`, the index in
+  // `tets` of the tet across face f (the face opposite local vertex f),
+  // 0xFFFFFFFF on the hull — the adjacency the flips kept up, in the form of
+  // SliverInput::neighbors and LabelInput::neighbor_tets.
+  std::vector<std::array<uint32_t, 4>> neighbors;
   SliverStats stats;
 };
 

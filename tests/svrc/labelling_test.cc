@@ -195,8 +195,16 @@ TEST(LabellingTest, GivenAdjacencyGivesTheSameLabelling) {
   in_place.tets = {};
   in_place.tet_vertices_of = [&](uint32_t t) { return nb.grid.tets[t]; };
   in_place.num_tets = nb.grid.tets.size();
-  for (const LabelInput* input : {&in, &in_place}) {
-    SCOPED_TRACE(input == &in ? "array" : "in place");
+  // The adjacency as an array of neighbour tets (the sliver pass's form):
+  // no function is read, the constrained faces are found in vertex stars.
+  std::vector<std::array<uint32_t, 4>> nbr_tets(nb.grid.tets.size());
+  for (uint32_t t = 0; t < nb.grid.tets.size(); ++t) {
+    for (int f = 0; f < 4; ++f) nbr_tets[t][f] = nbr[4 * t + f] == kNoTet ? kNoTet : nbr[4 * t + f] / 4;
+  }
+  LabelInput by_tets = nb.Input(seeds, holes);
+  by_tets.neighbor_tets = nbr_tets;
+  for (const LabelInput* input : {&in, &in_place, &by_tets}) {
+    SCOPED_TRACE(input == &in ? "array" : input == &in_place ? "in place" : "neighbour tets");
     auto given = LabelRegions(*input);
     ASSERT_TRUE(given.ok()) << given.status();
     EXPECT_EQ(given->tet_component, table->tet_component);
@@ -222,11 +230,39 @@ TEST(LabellingTest, GivenAdjacencyGivesTheSameLabelling) {
   LabelInput no_adjacency = in_place;
   no_adjacency.neighbor_slots_of = nullptr;
   EXPECT_EQ(LabelRegions(no_adjacency).status().code(), absl::StatusCode::kInvalidArgument);
+  // Neighbour tets: with tet_vertices_of, with a row count that is not the
+  // tets', with an id out of range, or not naming a constrained face's tet
+  // back, refused.
+  LabelInput tets_in_place = in_place;
+  tets_in_place.neighbor_tets = nbr_tets;
+  EXPECT_EQ(LabelRegions(tets_in_place).status().code(), absl::StatusCode::kInvalidArgument);
+  std::vector<std::array<uint32_t, 4>> short_rows(nbr_tets.begin(), nbr_tets.end() - 1);
+  LabelInput bad_rows = by_tets;
+  bad_rows.neighbor_tets = short_rows;
+  EXPECT_EQ(LabelRegions(bad_rows).status().code(), absl::StatusCode::kInvalidArgument);
+  std::vector<std::array<uint32_t, 4>> out_of_range = nbr_tets;
+  out_of_range[0][0] = static_cast<uint32_t>(nbr_tets.size());
+  bad_rows.neighbor_tets = out_of_range;
+  EXPECT_EQ(LabelRegions(bad_rows).status().code(), absl::StatusCode::kInvalidArgument);
+  {
+    // The far side of constrained face 0 forgets it.
+    std::array<uint32_t, 3> k = nb.faces[0].v;
+    std::sort(k.begin(), k.end());
+    const std::vector<uint32_t>& sl = slots_of.at(k);
+    ASSERT_EQ(sl.size(), 2u);
+    std::vector<std::array<uint32_t, 4>> one_sided = nbr_tets;
+    one_sided[sl[1] / 4][sl[1] % 4] = kNoTet;
+    one_sided[sl[0] / 4][sl[0] % 4] = sl[1] / 4;
+    bad_rows.neighbor_tets = one_sided;
+    EXPECT_EQ(LabelRegions(bad_rows).status().code(), absl::StatusCode::kInvalidArgument);
+  }
   // A constrained face that is no face of the tets is still an error.
   std::vector<ConstrainedFace> bad = nb.faces;
   bad.push_back({{0, 1, nb.grid.Id(8, 8, 8)}, 9, 0});
   in.constrained_faces = bad;
   EXPECT_FALSE(LabelRegions(in).ok());
+  by_tets.constrained_faces = bad;
+  EXPECT_FALSE(LabelRegions(by_tets).ok());
 }
 
 TEST(LabellingTest, KeepBoundingBoxKeepsEverything) {
