@@ -210,6 +210,10 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   options.max_volume = max_volume;
   const bool keep_box = complex->facets.empty();
   options.keep_bounding_box = keep_box;
+  // As core::MeshPlc: M_Ω's adjacency comes out of the refiner; there it goes
+  // through the flip pass to the output labelling, here straight to it
+  // (docs/svrc-design.md §8 item 82).
+  options.output_tet_neighbors = true;
   absl::StatusOr<refine::PointSetRefinement> refined = refine::RefinePlc(*complex, options);
   if (!refined.ok()) {
     std::printf("RESULT status=%s\n", std::string(absl::StatusCodeToString(refined.status().code())).c_str());
@@ -221,7 +225,7 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   const refine::CoordinateMap map = refine::CoordinateMapOf(*refined);
   absl::StatusOr<refine::OutputStageResult> out =
       refine::BuildOutputMesh(plc, refined->normalised_positions, refined->tets, complex->point_of_vertex,
-                              faces, map, keep_box, nullptr);
+                              faces, map, keep_box, nullptr, refined->tet_neighbors);
   if (!out.ok()) {
     std::printf("RESULT status=%s\n", std::string(absl::StatusCodeToString(out.status().code())).c_str());
     std::fprintf(stderr, "%s\n", out.status().ToString().c_str());
