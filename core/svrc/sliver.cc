@@ -286,6 +286,11 @@ class FlipMesh {
   // which t has an improving flip. The best sequence (largest worst new
   // quality) goes to `seq`; the mesh is left as it was.
   bool Search(uint32_t t, int depth, double floor, std::vector<Flip>* seq, double* score);
+  // An input tet outside the output (SliverOptions::skip_tet) that no flip
+  // replaced (version 0): not queued, not measured, not in the stats.
+  bool Skipped(uint32_t t) const {
+    return t < options_.skip_tet.size() && options_.skip_tet[t] != 0 && version_[t] == 0;
+  }
   // quality_[t] with its dihedral angles (computed now if Init left them).
   const Quality& Dihedrals(uint32_t t) const {
     Quality& q = quality_[t];
@@ -364,7 +369,10 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
     if (geom::Orient3d(pos_[v[0]], pos_[v[1]], pos_[v[2]], pos_[v[3]]) < 0) {
       return absl::InvalidArgumentError(absl::StrCat("sliver: tet ", t, " is negatively oriented"));
     }
-    quality_[t] = MeasureInput(pos_, v, sin_target);
+    // A skipped tet (outside the output) is never queued, never part of a
+    // flip (none crosses a constrained face) and not in the stats: not
+    // measured (its Quality stays default).
+    if (!Skipped(static_cast<uint32_t>(t))) quality_[t] = MeasureInput(pos_, v, sin_target);
   }
   // Adjacency: the 4T faces grouped by their vertex sets, as LabelRegions
   // does (tet_faces.h: no hashing, no sort of all 4T records, which took ~5%
@@ -655,8 +663,7 @@ void FlipMesh::Undo(const Journal& journal) {
 }
 
 void FlipMesh::Push(uint32_t t) {
-  // An input tet outside the output (never replaced: version 0) is skipped.
-  if (t < options_.skip_tet.size() && options_.skip_tet[t] != 0 && version_[t] == 0) return;
+  if (Skipped(t)) return;
   if (!quality_[t].dihedrals) return;  // every angle above the target
   if (quality_[t].min_dihedral < options_.target_min_dihedral_deg) {
     queue_.emplace(quality_[t].min_dihedral, t, version_[t]);
@@ -1167,13 +1174,18 @@ void FlipMesh::Run() {
 }
 
 void FlipMesh::Summarize(bool before) {
-  uint64_t count = 0, bad = 0;
+  uint64_t count = 0, measured = 0, bad = 0;
   double min_dih = kInf, max_dih = 0, max_re = 0;
   bool lazy = false;
   for (size_t t = 0; t < tet_.size(); ++t) {
     if (!alive_[t]) continue;
-    const Quality& q = quality_[t];
     ++count;
+    // The extremes and the bad count are over the tets the pass works on:
+    // with the exterior's, cube --max-volume 1e-3 reported a smallest angle
+    // of 0.62° and a radius-edge of 48.8 for an output of 15.05° and 1.29.
+    if (Skipped(static_cast<uint32_t>(t))) continue;
+    ++measured;
+    const Quality& q = quality_[t];
     max_re = std::max(max_re, q.radius_edge);
     if (!q.dihedrals) {
       lazy = true;  // not bad; its angles lie in (target, 180° − target)
@@ -1188,13 +1200,13 @@ void FlipMesh::Summarize(bool before) {
   const double target = options_.target_min_dihedral_deg;
   if (lazy && (!(min_dih < target) || !(max_dih >= 180 - target))) {
     for (size_t t = 0; t < tet_.size(); ++t) {
-      if (!alive_[t] || quality_[t].dihedrals) continue;
+      if (!alive_[t] || Skipped(static_cast<uint32_t>(t)) || quality_[t].dihedrals) continue;
       const Quality& q = Dihedrals(static_cast<uint32_t>(t));
       min_dih = std::min(min_dih, q.min_dihedral);
       max_dih = std::max(max_dih, q.max_dihedral);
     }
   }
-  if (count == 0) min_dih = 0;
+  if (measured == 0) min_dih = 0;
   if (before) {
     stats_->tets_before = count;
     stats_->bad_before = bad;

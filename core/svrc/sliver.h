@@ -108,9 +108,12 @@ SliverTetQuality MeasureSliverTet(const geom::Vec3& a, const geom::Vec3& b, cons
 
 // Statistics of one run (exported as "sliver.*" counters).
 struct SliverStats {
-  uint64_t tets_before = 0, tets_after = 0;
-  // Tets whose smallest dihedral angle is below the target (all tets of the
-  // input, exterior included: the pass runs before labelling).
+  uint64_t tets_before = 0, tets_after = 0;  // all tets, SliverOptions::skip_tet's included
+  // Over the tets the pass works on (not skip_tet's, which are neither
+  // measured nor flipped): those whose smallest dihedral angle is below the
+  // target, and the extremes. With the exterior's (before session 49) cube
+  // --max-volume 1e-3 reported 0.62° and radius-edge 48.8 for an output of
+  // 15.05° and 1.29.
   uint64_t bad_before = 0, bad_after = 0;
   double min_dihedral_before = 0, min_dihedral_after = 0;  // degrees, worst tet
   double max_dihedral_before = 0, max_dihedral_after = 0;  // degrees, worst tet
