@@ -123,6 +123,7 @@ TEST(MeshPlcTest, SliverStatsDescribeTheOutput) {
     const double re_after = m->stats.Get("sliver.max_radius_edge_after", -1);
     EXPECT_NEAR(min_after, q.all.min_dihedral_deg.min, 1e-6 * q.all.min_dihedral_deg.min);
     EXPECT_NEAR(re_after, q.all.radius_edge.max, 1e-6 * q.all.radius_edge.max);
+    EXPECT_NEAR(m->stats.Get("sliver.max_dihedral_after", -1), q.all.dihedral_deg.max, 1e-6 * q.all.dihedral_deg.max);
     EXPECT_LE(m->stats.Get("sliver.max_radius_edge_before", 1e9), params.radius_edge * (1 + 1e-9));
     // The pass counts every tet, exterior included.
     EXPECT_GT(m->stats.Get("sliver.tets_after"), static_cast<double>(m->tets.size()));

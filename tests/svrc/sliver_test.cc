@@ -562,6 +562,39 @@ TEST(Sliver, SkippedAnglesLeaveTheStatisticsExact) {
     EXPECT_EQ(r->stats.min_dihedral_after, min_after) << "target " << target;
     EXPECT_EQ(r->stats.max_dihedral_after, max_after) << "target " << target;
   }
+  // With skip_tet (session 49): the statistics are over the other tets only.
+  // Skipping every tet with an angle outside (20°, 150°) leaves no measured
+  // tet near 180° − target, so the lazy tets decide the extremes (read by
+  // their sines, FlipMesh::Summarize); no tet is bad at this target, so
+  // nothing flips and "after" is "before".
+  std::vector<uint8_t> skip(del->tets.size(), 0);
+  std::vector<Tet> kept;
+  for (size_t t = 0; t < del->tets.size(); ++t) {
+    Tet s = del->tets[t];
+    std::sort(s.begin(), s.end());
+    const SliverTetQuality q = MeasureSliverTet(pos[s[0]], pos[s[1]], pos[s[2]], pos[s[3]]);
+    skip[t] = q.min_dihedral_deg <= 20 || q.max_dihedral_deg >= 150;
+    if (!skip[t]) kept.push_back(del->tets[t]);
+  }
+  ASSERT_GT(kept.size(), 10u);
+  ASSERT_LT(kept.size(), del->tets.size());
+  const auto [min_kept, max_kept] = extremes(kept);
+  SliverInput in;
+  in.positions = pos;
+  in.tets = del->tets;
+  SliverOptions opt;
+  opt.target_min_dihedral_deg = 15;
+  opt.max_radius_edge = 1e9;
+  opt.skip_tet = skip;
+  absl::StatusOr<SliverResult> r = RemoveSlivers(in, opt);
+  ASSERT_TRUE(r.ok()) << r.status();
+  EXPECT_EQ(r->stats.bad_before, 0u);
+  EXPECT_EQ(r->stats.tets_before, del->tets.size());
+  EXPECT_EQ(r->stats.min_dihedral_before, min_kept);
+  EXPECT_EQ(r->stats.max_dihedral_before, max_kept);
+  EXPECT_EQ(r->stats.min_dihedral_after, min_kept);
+  EXPECT_EQ(r->stats.max_dihedral_after, max_kept);
+  EXPECT_EQ(r->tets, del->tets);
 }
 
 // The pass's own quality evaluation skips atan2 for edges that cannot hold
