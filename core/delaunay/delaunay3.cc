@@ -711,9 +711,10 @@ void Delaunay3::set_cache_neighbors(bool on) {
 
 // Appends nbr_buf_[0, m) to the pool as v's list. The vertices stored since
 // the last flush are listed (adj_stored_). When the pool is full it is
-// rebuilt from that list with only the live lists and room for half as many
-// again: copying is amortised over at least live/2 appends, and the pool
-// never holds more than ~1.5× the live lists (~3× while being rebuilt). With
+// packed in place to its live lists, with room for half as many again:
+// copying is amortised over at least live/2 appends, and the pool never
+// holds more than ~1.5× the most lists live at once (session 49: no second
+// pool while packing). With
 // a limit (adj_limit_ != 0), when the live lists would pass it every list on
 // the list is dropped instead (a flush). Both cost what the stores since the
 // last rebuild did, not a pass over every vertex (a run with 10^7 vertices
@@ -728,24 +729,41 @@ void Delaunay3::StoreAdj(uint32_t v, uint32_t m) const {
       adj_live_ = 0;
       ++adj_flushes_;
     } else {
-      // A vertex may be listed twice (stored, invalidated, stored again):
-      // kCopied marks the lists already moved.
-      constexpr uint32_t kCopied = 0x80000000u;
-      std::vector<VertexId> pool;
-      pool.reserve(adj_live_ + adj_live_ / 2 + m + 1024);
-      std::vector<uint32_t> stored;
-      for (uint32_t w : adj_stored_) {
-        AdjEntry& e = adj_[w];
-        if (e.size == kNoAdj || (e.size & kCopied) != 0) continue;
-        const uint32_t off = static_cast<uint32_t>(pool.size());
-        pool.insert(pool.end(), adj_pool_.begin() + e.offset, adj_pool_.begin() + e.offset + e.size);
-        e.offset = off;
-        e.size |= kCopied;
-        stored.push_back(w);
+      // Packed in place, without a second pool (which had been the heap
+      // peak of cube --max-volume 1e-4's refinement: the old pool and the
+      // new one at once, +115 KB). A vertex may be listed twice (stored,
+      // invalidated, stored again); its live list is the one of its latest
+      // listing, and those come in the order of their offsets (each store
+      // appends), so one forward pass of memmoves moves every live list
+      // down. A backward pass first blanks every listing but the latest
+      // (kSeen marks the vertices met).
+      constexpr uint32_t kSeen = 0x80000000u;
+      constexpr uint32_t kBlank = 0xFFFFFFFFu;
+      for (size_t i = adj_stored_.size(); i-- > 0;) {
+        AdjEntry& e = adj_[adj_stored_[i]];
+        if (e.size == kNoAdj || (e.size & kSeen) != 0) {
+          adj_stored_[i] = kBlank;
+        } else {
+          e.size |= kSeen;
+        }
       }
-      for (uint32_t w : stored) adj_[w].size &= ~kCopied;
-      adj_pool_.swap(pool);
-      adj_stored_.swap(stored);
+      VertexId* pool = adj_pool_.data();
+      size_t next = 0, kept = 0;
+      for (const uint32_t w : adj_stored_) {
+        if (w == kBlank) continue;
+        AdjEntry& e = adj_[w];
+        e.size &= ~kSeen;
+        if (e.offset != next) std::memmove(pool + next, pool + e.offset, e.size * sizeof(VertexId));
+        e.offset = static_cast<uint32_t>(next);
+        next += e.size;
+        adj_stored_[kept++] = w;
+      }
+      adj_stored_.resize(kept);
+      adj_pool_.resize(next);
+      ++adj_packs_;
+      // Room for half as many again: the packing stays amortised over at
+      // least live/2 appends.
+      if (adj_pool_.capacity() < next + next / 2 + m + 1024) adj_pool_.reserve(next + next / 2 + m + 1024);
     }
   }
   adj_stored_.push_back(v);

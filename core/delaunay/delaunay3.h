@@ -117,6 +117,8 @@ class Delaunay3 {
   void set_neighbor_cache_limit(size_t entries) { adj_limit_ = entries; }
   // Lists dropped that way (cache flushes), for tests.
   uint64_t neighbor_cache_flushes() const { return adj_flushes_; }
+  // Times the neighbour lists were packed in place (StoreAdj).
+  uint64_t neighbor_cache_packs() const { return adj_packs_; }
 
   // Inserts `p` with SoS priority `global_id`. `hint` is any live tet near p
   // (kNoneTet: the last created tet): if it conflicts with p the cavity grows
@@ -369,6 +371,7 @@ class Delaunay3 {
   size_t adj_limit_ = size_t{1} << 20;
   mutable std::vector<uint32_t> adj_stored_;  // vertices stored since the last flush (StoreAdj)
   mutable uint64_t adj_flushes_ = 0;
+  mutable uint64_t adj_packs_ = 0;
   bool report_cavity_vertices_ = true;
   Stats stats_;
 };
