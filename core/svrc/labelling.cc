@@ -275,46 +275,16 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       }
     }
   }
-  // With the array: the tets at each constrained face's smallest vertex
-  // (CSR, ascending tet index), where the face is looked for.
-  std::vector<uint32_t> star_start, star_tet;
+  // With the array: the tets at each constrained face's smallest vertex,
+  // whose faces there stand in for the table's buckets (StarBucket).
+  VertexStars stars;
   if (slot_array) {
     std::vector<uint8_t> first(nv, 0);
     for (const ConstrainedFace& cf : in.constrained_faces) {
       first[std::min({cf.v[0], cf.v[1], cf.v[2]})] = 1;
     }
-    star_start.assign(nv + 1, 0);
-    for (size_t t = 0; t < nt; ++t) {
-      for (uint32_t v : in.tets[t]) star_start[v + 1] += first[v];
-    }
-    for (size_t v = 0; v < nv; ++v) star_start[v + 1] += star_start[v];
-    star_tet.resize(star_start[nv]);
-    std::vector<uint32_t> fill(star_start.begin(), star_start.end() - 1);
-    for (size_t t = 0; t < nt; ++t) {
-      for (uint32_t v : in.tets[t]) {
-        if (first[v]) star_tet[fill[v]++] = static_cast<uint32_t>(t);
-      }
-    }
+    stars = StarsOf(in.tets, nv, first);
   }
-  // Some slot of face {a, b, c} (a its smallest vertex), from the given
-  // function or the stars: the first tet at a holding b and c.
-  auto find_face = [&](uint32_t a, uint32_t b, uint32_t c) -> uint32_t {
-    if (!slot_array) return in.find_face(a, b, c);
-    for (uint32_t i = star_start[a]; i < star_start[a + 1]; ++i) {
-      const uint32_t t = star_tet[i];
-      const std::array<uint32_t, 4>& tv = in.tets[t];
-      int found = 0, other = -1;
-      for (int k = 0; k < 4; ++k) {
-        if (tv[k] == a || tv[k] == b || tv[k] == c) {
-          ++found;
-        } else {
-          other = k;
-        }
-      }
-      if (found == 3 && other >= 0) return 4 * t + static_cast<uint32_t>(other);
-    }
-    return kNoTet;
-  };
   std::optional<TetFaces> tet_faces;
   std::vector<uint32_t> own_nbr;
   if (!given) {
@@ -375,21 +345,31 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       keys[i] = {Sorted3(in.constrained_faces[i].v), static_cast<uint32_t>(i)};
     }
     std::sort(keys.begin(), keys.end());
-    // Without a given face lookup: each key's first record (smallest slot).
-    // The keys of one smallest vertex a (a sorted run) are scanned for in a's
-    // bucket, or with more than kConstraintScanRun of them the bucket is read
-    // once and its records looked up in the run (the first of equal keys;
-    // tet_faces.h: crease_pair_0.1deg's output, 10 M vertices).
+    // Without a given face lookup (the table, or the array's stars): each
+    // key's first record (smallest slot). The keys of one smallest vertex a
+    // (a sorted run) are scanned for in a's bucket, or with more than
+    // kConstraintScanRun of them the bucket is read once and its records
+    // looked up in the run (the first of equal keys; tet_faces.h:
+    // crease_pair_0.1deg's output, 10 M vertices).
+    const bool find_in_buckets = !given || slot_array;
     std::vector<uint32_t> key_slot;
-    if (!given) {
+    std::vector<TetFace> star_bucket;
+    if (find_in_buckets) {
       key_slot.assign(ncf, kNoTet);
       for (size_t i = 0; i < ncf;) {
         const uint32_t a = keys[i].first[0];
         size_t j = i;
         while (j < ncf && keys[j].first[0] == a) ++j;
+        std::span<const TetFace> bucket;
+        if (slot_array) {
+          StarBucket(in.tets, stars, a, &star_bucket);
+          bucket = star_bucket;
+        } else {
+          bucket = tet_faces->Bucket(a);
+        }
         if (j - i <= kConstraintScanRun) {
           for (size_t r = i; r < j; ++r) {
-            for (const TetFace& f : tet_faces->Bucket(a)) {
+            for (const TetFace& f : bucket) {
               if (f.b == keys[r].first[1] && f.c == keys[r].first[2]) {
                 key_slot[r] = f.slot;  // records of one face come smallest slot first
                 break;
@@ -397,7 +377,7 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
             }
           }
         } else {
-          for (const TetFace& f : tet_faces->Bucket(a)) {
+          for (const TetFace& f : bucket) {
             const std::array<uint32_t, 3> k{a, f.b, f.c};
             const auto it = std::lower_bound(keys.begin() + i, keys.begin() + j, k,
                                              [](const auto& e, const std::array<uint32_t, 3>& x) { return e.first < x; });
@@ -434,8 +414,8 @@ absl::StatusOr<Labelling> LabelRegions(const LabelInput& in) {
       // The face's first record (smallest slot): in the bucket of k[0], or
       // the smaller of the given slot and its neighbour.
       uint32_t first_slot = kNoTet;
-      if (given) {
-        const uint32_t s = find_face(k[0], k[1], k[2]);
+      if (!find_in_buckets) {
+        const uint32_t s = in.find_face(k[0], k[1], k[2]);
         if (s != kNoTet) {
           const uint32_t other = nbr(s);
           first_slot = other != kNoTet ? std::min(s, other) : s;

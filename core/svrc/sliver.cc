@@ -270,15 +270,10 @@ class FlipMesh {
   void Summarize(bool before);
 
  private:
-  // Vertex -> live tets (CSR: the tets at v are star[start[v] .. start[v+1])),
-  // for the first vertices of the constraints only (the scatter of all 4T
-  // incidences was most of the cost; boundary vertices are a fraction of all).
-  struct ConstraintStars {
-    std::vector<uint32_t> start, star;
-  };
-  ConstraintStars BuildConstraintStars() const;
+  // Vertex -> live tets (StarsOf) for the first vertices of the constraints.
+  VertexStars BuildConstraintStars() const;
   // CheckConstraints on stars already built for the current tets.
-  absl::Status CheckConstraints(const ConstraintStars& stars) const;
+  absl::Status CheckConstraints(const VertexStars& stars) const;
   bool FaceConstrained(const Tri& f) const {
     return std::binary_search(cfaces_.begin(), cfaces_.end(), f);
   }
@@ -488,25 +483,12 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   // bucket; CheckConstraints reads them (with the table, built after it is
   // freed).
   const bool table = tet_faces.has_value();
-  ConstraintStars stars;
+  VertexStars stars;
   if (!table) stars = BuildConstraintStars();
   std::vector<TetFace> bucket;
   auto bucket_of = [&](uint32_t a) -> std::span<const TetFace> {
     if (table) return tet_faces->Bucket(a);
-    bucket.clear();
-    for (uint32_t k = stars.start[a]; k < stars.start[a + 1]; ++k) {
-      const uint32_t t = stars.star[k];
-      const Tet& v = tet_[t];
-      for (uint32_t f = 0; f < 4; ++f) {
-        if (v[f] == a) continue;  // the face opposite f holds a unless v[f] is a
-        std::array<uint32_t, 3> x;
-        for (uint32_t g = 0, m = 0; g < 4; ++g) {
-          if (g != f) x[m++] = v[g];
-        }
-        std::sort(x.begin(), x.end());
-        if (x[0] == a) bucket.push_back({x[1], x[2], 4 * t + f});
-      }
-    }
+    StarBucket(tet_, stars, a, &bucket);
     return bucket;
   };
   for (size_t i = 0; i < cfaces_.size();) {
@@ -557,38 +539,22 @@ absl::Status FlipMesh::Init(const SliverInput& in) {
   return absl::OkStatus();
 }
 
-FlipMesh::ConstraintStars FlipMesh::BuildConstraintStars() const {
-  ConstraintStars out;
-  if (cfaces_.empty() && cedges_.empty()) return out;
+VertexStars FlipMesh::BuildConstraintStars() const {
+  if (cfaces_.empty() && cedges_.empty()) return {};
   std::vector<uint8_t> needed(pos_.size(), 0);
   for (const Tri& f : cfaces_) needed[f[0]] = 1;
   for (const Edge& e : cedges_) needed[e[0]] = 1;
-  std::vector<uint32_t>& start = out.start;
-  start.assign(pos_.size() + 1, 0);
-  for (size_t t = 0; t < tet_.size(); ++t) {
-    if (!alive_[t]) continue;
-    for (uint32_t v : tet_[t]) start[v + 1] += needed[v];
-  }
-  for (size_t v = 0; v < pos_.size(); ++v) start[v + 1] += start[v];
-  out.star.resize(start.back());
-  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  for (size_t t = 0; t < tet_.size(); ++t) {
-    if (!alive_[t]) continue;
-    for (uint32_t v : tet_[t]) {
-      if (needed[v]) out.star[fill[v]++] = static_cast<uint32_t>(t);
-    }
-  }
-  return out;
+  return StarsOf(tet_, pos_.size(), needed, alive_);
 }
 
 absl::Status FlipMesh::CheckConstraints() const { return CheckConstraints(BuildConstraintStars()); }
 
-absl::Status FlipMesh::CheckConstraints(const ConstraintStars& stars) const {
+absl::Status FlipMesh::CheckConstraints(const VertexStars& stars) const {
   // Each constraint is looked up in the star of its first vertex.
   // O(T + constraints · degree), no sort.
   if (cfaces_.empty() && cedges_.empty()) return absl::OkStatus();
   const std::vector<uint32_t>& start = stars.start;
-  const std::vector<uint32_t>& star = stars.star;
+  const std::vector<uint32_t>& star = stars.tet;
   // The constraints whose first vertex is a (sorted runs of cfaces_ and
   // cedges_) are each scanned for in a's star, or with more than
   // kConstraintScanRun of them the star is read once and the faces and edges

@@ -106,4 +106,43 @@ bool TetFaces::Match(absl::FunctionRef<void(uint32_t, uint32_t)> pair, Overused*
   return true;
 }
 
+VertexStars StarsOf(std::span<const std::array<uint32_t, 4>> tets, size_t num_vertices,
+                    std::span<const uint8_t> flagged, std::span<const uint8_t> alive) {
+  VertexStars out;
+  std::vector<uint32_t>& start = out.start;
+  start.assign(num_vertices + 1, 0);
+  for (size_t t = 0; t < tets.size(); ++t) {
+    if (!alive.empty() && !alive[t]) continue;
+    for (uint32_t v : tets[t]) start[v + 1] += flagged[v];
+  }
+  for (size_t v = 0; v < num_vertices; ++v) start[v + 1] += start[v];
+  out.tet.resize(start.back());
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t t = 0; t < tets.size(); ++t) {
+    if (!alive.empty() && !alive[t]) continue;
+    for (uint32_t v : tets[t]) {
+      if (flagged[v]) out.tet[fill[v]++] = static_cast<uint32_t>(t);
+    }
+  }
+  return out;
+}
+
+void StarBucket(std::span<const std::array<uint32_t, 4>> tets, const VertexStars& stars, uint32_t a,
+                std::vector<TetFace>* out) {
+  out->clear();
+  for (uint32_t k = stars.start[a]; k < stars.start[a + 1]; ++k) {
+    const uint32_t t = stars.tet[k];
+    const std::array<uint32_t, 4>& v = tets[t];
+    for (uint32_t f = 0; f < 4; ++f) {
+      if (v[f] == a) continue;  // the face opposite f holds a unless v[f] is a
+      std::array<uint32_t, 3> x;
+      for (uint32_t g = 0, m = 0; g < 4; ++g) {
+        if (g != f) x[m++] = v[g];
+      }
+      std::sort(x.begin(), x.end());
+      if (x[0] == a) out->push_back({x[1], x[2], 4 * t + f});
+    }
+  }
+}
+
 }  // namespace svrc::refine

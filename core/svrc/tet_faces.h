@@ -59,4 +59,20 @@ class TetFaces {
   std::vector<TetFace> faces_;
 };
 
+// The tets at each flagged vertex, in ascending tet index (CSR): those at v
+// are tet[start[v] .. start[v+1]). Only flagged vertices get a star (the
+// scatter of all 4T incidences was most of the cost; the callers flag the
+// smallest vertices of their constraints). `alive` (empty: every slot) leaves
+// out dead slots.
+struct VertexStars {
+  std::vector<uint32_t> start, tet;
+};
+VertexStars StarsOf(std::span<const std::array<uint32_t, 4>> tets, size_t num_vertices,
+                    std::span<const uint8_t> flagged, std::span<const uint8_t> alive = {});
+// TetFaces::Bucket(a) without the table: the faces at flagged vertex a whose
+// smallest vertex is a, from a's star, in tet order (so the records of one
+// face come smallest slot first), into *out.
+void StarBucket(std::span<const std::array<uint32_t, 4>> tets, const VertexStars& stars, uint32_t a,
+                std::vector<TetFace>* out);
+
 }  // namespace svrc::refine
