@@ -70,6 +70,7 @@ int RunValidate(const std::vector<std::string>& args) {
                 fc->NumCreasePoints());
     std::printf("spread     %.6g (diameter %.6g / min distance between disjoint features %.6g)\n",
                 fc->spread, fc->diameter, fc->min_feature_distance);
+    if (!fc->closest_features.empty()) std::printf("closest    %s\n", fc->closest_features.c_str());
   }
   for (const plc::Problem& w : report.warnings) std::printf("warning: %s\n", w.message.c_str());
   for (const plc::Problem& e : report.errors) std::printf("error: %s\n", e.message.c_str());

@@ -7,6 +7,9 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <string>
+
+#include "absl/strings/str_cat.h"
 
 #include "core/plc/features_internal.h"
 #include "core/plc/grid.h"
@@ -206,8 +209,21 @@ void ComputeSpread(FeatureComplex* fc) {
   fc->diameter = bounds.Diagonal();
   fc->min_feature_distance = 0;
   fc->spread = 0;
+  fc->closest_features.clear();
   if (np == 0) return;
   double d = std::numeric_limits<double>::infinity();
+  // Which two features d is between (kind 0 point, 1 segment, 2 facet).
+  struct Feature {
+    int kind = 0;
+    uint32_t id = 0;
+  };
+  Feature near_a, near_b;
+  auto closer = [&](double dist, Feature a, Feature b) {
+    if (!(dist < d)) return;
+    d = dist;
+    near_a = a;
+    near_b = b;
+  };
   // Closest pair of points: grid pairs within h, doubling h until one is found.
   if (np >= 2) {
     const Vec3 ext = bounds.hi - bounds.lo;
@@ -219,7 +235,9 @@ void ComputeSpread(FeatureComplex* fc) {
         const Vec3 e(h / 2, h / 2, h / 2);
         grid.Insert(Box3{P(p) - e, P(p) + e});
       }
-      grid.ForEachOverlappingPair([&](uint32_t i, uint32_t j) { d = std::min(d, geom::Dist(P(i), P(j))); });
+      grid.ForEachOverlappingPair([&](uint32_t i, uint32_t j) {
+        closer(geom::Dist(P(i), P(j)), {0, std::min(i, j)}, {0, std::max(i, j)});
+      });
     }
   }
   // Points vs segments and facet triangles, segments vs segments, within d.
@@ -269,17 +287,18 @@ void ComputeSpread(FeatureComplex* fc) {
       if (x.kind > y.kind) std::swap(x, y);
       if (x.kind == 0 && y.kind == 1) {
         const FeatureSegment& s = fc->segments[y.a];
-        if (x.a != s.a && x.a != s.b) d = std::min(d, PointSegmentDistance(P(x.a), P(s.a), P(s.b)));
+        if (x.a != s.a && x.a != s.b) closer(PointSegmentDistance(P(x.a), P(s.a), P(s.b)), {0, x.a}, {1, y.a});
       } else if (x.kind == 0 && y.kind == 2) {
         if (!std::binary_search(facet_points[y.a].begin(), facet_points[y.a].end(), x.a)) {
           const auto& t = fc->facets[y.a].triangles[y.b];
-          d = std::min(d, PointTriangleDistance(P(x.a), P(t[0]), P(t[1]), P(t[2])));
+          closer(PointTriangleDistance(P(x.a), P(t[0]), P(t[1]), P(t[2])), {0, x.a}, {2, y.a});
         }
       } else if (x.kind == 1 && y.kind == 1) {
         const FeatureSegment& s = fc->segments[x.a];
         const FeatureSegment& t = fc->segments[y.a];
         if (s.a != t.a && s.a != t.b && s.b != t.a && s.b != t.b) {
-          d = std::min(d, SegmentSegmentDistance(P(s.a), P(s.b), P(t.a), P(t.b)));
+          closer(SegmentSegmentDistance(P(s.a), P(s.b), P(t.a), P(t.b)), {1, std::min(x.a, y.a)},
+                 {1, std::max(x.a, y.a)});
         }
       }
     });
@@ -287,6 +306,16 @@ void ComputeSpread(FeatureComplex* fc) {
   if (std::isfinite(d) && d > 0) {
     fc->min_feature_distance = d;
     fc->spread = fc->diameter / d;
+    auto name = [&](Feature f) -> std::string {
+      if (f.kind == 0) {
+        const Vec3& x = P(f.id);
+        return absl::StrCat("point ", f.id, " (", x.x, ", ", x.y, ", ", x.z, ")");
+      }
+      if (f.kind == 1) return absl::StrCat("segment (", fc->segments[f.id].a, ", ", fc->segments[f.id].b, ")");
+      const uint32_t input = fc->facets[f.id].input_facet;
+      return absl::StrCat("facet ", input != kNoId ? input : f.id);
+    };
+    fc->closest_features = absl::StrCat(name(near_a), " and ", name(near_b));
   }
 }
 

@@ -102,6 +102,11 @@ struct FeatureComplex {
   double diameter = 0;
   double min_feature_distance = 0;
   double spread = 0;
+  // The two features min_feature_distance is measured between, for messages:
+  // "point 8 (x, y, z) and facet 7" (points numbered as in Plc::points from
+  // 0, facets as in Plc::facets, a segment piece by its end points); empty
+  // when spread is 0.
+  std::string closest_features;
 
   size_t NumCreasePoints() const;
   size_t NumCreaseSegments() const;

@@ -825,9 +825,16 @@ class Refiner {
   // Where the budget came from, for its error: the default (max(10^6, 2000 ×
   // input points)) can be raised.
   std::string BudgetHint() const {
-    if (options_.max_vertices != 0) return " (a budget set by the caller)";
+    // The mesh grades down to the input's smallest gap between disjoint
+    // features: name them, the usual reason a valid input needs so many.
+    std::string gap;
+    if (complex_ != nullptr && !complex_->closest_features.empty()) {
+      gap = absl::StrCat("; the input's closest disjoint features are ", complex_->closest_features, ", ",
+                         complex_->min_feature_distance, " apart (spread ", complex_->spread, ")");
+    }
+    if (options_.max_vertices != 0) return absl::StrCat(" (a budget set by the caller", gap, ")");
     return absl::StrCat(" (the default: max(1000000, 2000 x ", num_input_,
-                        " input points); a larger max_vertices (svrc mesh --max-vertices N) lets it go on)");
+                        " input points); a larger max_vertices (svrc mesh --max-vertices N) lets it go on", gap, ")");
   }
   // The cell size IsLive computed for the event Destroy gets next.
   CellSize last_size_;

@@ -230,6 +230,42 @@ TEST(Features, Spread) {
   EXPECT_NEAR(bb.min_feature_distance, 0.1, 1e-12);
 }
 
+// The pair the smallest gap is measured between, as messages name it
+// (input numbering from 0, a segment by its end points).
+Plc UnitCubePlc() {
+  Plc plc;
+  plc.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  plc.facets = {Quad(0, 1, 2, 3), Quad(4, 5, 6, 7), Quad(0, 1, 5, 4),
+                Quad(1, 2, 6, 5), Quad(2, 3, 7, 6), Quad(3, 0, 4, 7)};
+  return plc;
+}
+
+TEST(Features, SpreadNamesTheClosestFeatures) {
+  Plc point = UnitCubePlc();
+  point.vertices.push_back({0.5, 0.5, 1e-6});  // an isolated point just above the bottom facet
+  const FeatureComplex fp = MustBuild(point);
+  EXPECT_NEAR(fp.min_feature_distance, 1e-6, 1e-18);
+  EXPECT_EQ(fp.closest_features, "point 8 (0.5, 0.5, 1e-06) and facet 0");
+
+  Plc segs = UnitCubePlc();  // two free skew segments 2e-5 apart
+  segs.vertices.insert(segs.vertices.end(), {{0.2, 0.5, 0.5}, {0.8, 0.5, 0.5}, {0.5, 0.2, 0.50002}, {0.5, 0.8, 0.50002}});
+  segs.segments = {{8, 9, 0}, {10, 11, 0}};
+  const FeatureComplex fs = MustBuild(segs);
+  EXPECT_NEAR(fs.min_feature_distance, 2e-5, 1e-15);
+  EXPECT_EQ(fs.closest_features, "segment (8, 9) and segment (10, 11)");
+
+  Plc near_seg = UnitCubePlc();  // an isolated point 3e-4 from a free segment
+  near_seg.vertices.insert(near_seg.vertices.end(), {{0.2, 0.5, 0.5}, {0.8, 0.5, 0.5}, {0.4, 0.5003, 0.5}});
+  near_seg.segments = {{8, 9, 0}};
+  const FeatureComplex fn = MustBuild(near_seg);
+  EXPECT_NEAR(fn.min_feature_distance, 3e-4, 1e-12);
+  EXPECT_EQ(fn.closest_features, "point 10 (0.4, 0.5003, 0.5) and segment (8, 9)");
+
+  const FeatureComplex cube = MustBuild(UnitCubePlc());  // no two disjoint features closer than the side
+  EXPECT_NEAR(cube.min_feature_distance, 1, 1e-15);
+  EXPECT_FALSE(cube.closest_features.empty());
+}
+
 TEST(Features, ExampleHoleAndRegions) {
   const FeatureComplex ex = MustBuildFile("b_internal/example.poly");
   // Facet 3 has a hole loop (the inner box's face fills it with facet 20).

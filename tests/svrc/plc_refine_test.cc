@@ -146,6 +146,33 @@ TEST(PlcRefine, MildCreaseWithMaxVolumeBeyondTheInputBudget) {
   EXPECT_LE(worst, 3e-4);
 }
 
+// A valid input whose smallest gap needs more vertices than the budget: the
+// message names the two features and their distance (session 50; the random
+// sweep's near 49, two triangles 2e-7 apart, said only "vertex budget of
+// 1000000 reached").
+TEST(PlcRefine, BudgetMessageNamesTheClosestFeatures) {
+  plc::Plc plc;
+  plc.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1},
+                  {0.5, 0.5, 1e-6}};
+  auto quad = [](uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
+    plc::Facet f;
+    f.polygons.push_back(plc::Polygon{{a, b, c, d}});
+    return f;
+  };
+  plc.facets = {quad(0, 1, 2, 3), quad(4, 5, 6, 7), quad(0, 1, 5, 4),
+                quad(1, 2, 6, 5), quad(2, 3, 7, 6), quad(3, 0, 4, 7)};
+  core::MeshParams params;
+  params.max_vertices = 300;
+  absl::StatusOr<mesh::TetMesh> m = core::MeshPlc(plc, params);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.status().code(), absl::StatusCode::kResourceExhausted) << m.status();
+  EXPECT_NE(m.status().message().find("vertex budget of 300 reached"), std::string::npos) << m.status();
+  EXPECT_NE(m.status().message().find("the input's closest disjoint features are point 8 (0.5, 0.5, 1e-06) and "
+                                      "facet 0, 1e-06 apart (spread 1.73205e+06)"),
+            std::string::npos)
+      << m.status();
+}
+
 // Every generated family without creases (core/plc/families.h): boxes with
 // internal facets, a hole, a cavity, a tunnel (facets with holes), an
 // internal facet with a polygonal hole, free segments and isolated points,
