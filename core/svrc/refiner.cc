@@ -763,6 +763,7 @@ class Refiner {
   void DropDeadTetEvents(std::span<const TetId> destroyed);
   // Collars (stage (d)).
   const plc::FeatureComplex* complex_ = nullptr;
+  plc::FeatureComplex own_complex_;  // the point-set path's complex (Initialize)
   CollarIndex collars_;
   std::vector<PointId> collar_centre_;          // per collar
   std::vector<uint8_t> has_collar_;             // per point
@@ -953,8 +954,12 @@ absl::Status Refiner::Initialize(std::span<const Vec3> normalised, std::span<con
           (k > 0 && normalised[order[k - 1]] == normalised[i]) ? duplicate_of_[order[k - 1]] : i;
     }
   }
-  // The feature complex of points + free segments (superfeature lists).
-  plc::FeatureComplex complex;
+  // The feature complex of points + free segments (superfeature lists). The
+  // refiner keeps it: Setup points complex_ at it for the whole run (a local
+  // here had left complex_ dangling once Initialize returned; session 50's
+  // budget message read it, caught by ASan in RefinerTest.BudgetAndCancellation).
+  plc::FeatureComplex& complex = own_complex_;
+  complex = plc::FeatureComplex{};
   complex.points.resize(num_input_);
   for (size_t s = 0; s < segments.size(); ++s) {
     const uint32_t a = segments[s].a, b = segments[s].b;
