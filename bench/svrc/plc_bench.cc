@@ -32,7 +32,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <condition_variable>
 #include <cerrno>
 #include <chrono>
@@ -104,7 +103,7 @@ void KillChildAndExit(int sig) {
 
 // fork/exec `argv` in `dir` (stdout, stderr to files there), RLIMIT_AS =
 // mem_limit bytes (0: none), its own process group; SIGKILL to the group
-// after `timeout_s`. The wait blocks in wait4 while a watchdog thread keeps
+// after `timeout_s`. The wait blocks in waitid while a watchdog thread keeps
 // the time limit, so the wall time is the child's own to the microsecond
 // (session 50: a poll with doubling sleeps, 0.5 → 20 ms, had rounded every
 // short run up to the next poll, 7.5 / 15.5 / 31.5 / 51.5 ms, …).
@@ -141,7 +140,7 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const fs::path& d
   std::mutex mu;
   std::condition_variable done_cv;
   bool done = false;
-  std::atomic<bool> killed{false};
+  bool killed = false;  // the watchdog's, read after join
   std::thread watchdog([&] {
     std::unique_lock<std::mutex> lock(mu);
     const auto limit = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
