@@ -510,10 +510,15 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
     first = false;
   }
   std::printf("\n");
-  // Diagnostics, not the criterion: per tet of the whole M_Ω (the
-  // bounding-domain mesh the refiner builds, output or not), and the marginal
-  // cost between consecutive runs (a fixed per-run cost cancels out).
+  // Diagnostics, not the criterion: per output vertex (a boundary
+  // vertex has fewer tets than an interior one, so the small runs have fewer
+  // tets per vertex: cube 1e-4 5.1, 1e-6 6.0; bench/RESULTS.md "Session 51"),
+  // per tet of the whole M_Ω (the bounding-domain mesh the refiner builds,
+  // output or not), and the marginal cost between consecutive runs (a fixed
+  // per-run cost cancels out).
   const Measure omega[] = {
+      {"cpu µs per output vertex", [](const Row& r) { return 1e6 * r.cpu / r.r.D("out_vertices"); }},
+      {"peak heap B per output vertex", [](const Row& r) { return r.heap_b * r.tets / r.r.D("out_vertices"); }},
       {"cpu µs per M_Ω tet", [](const Row& r) { return 1e6 * r.cpu / r.r.D("omega_tets"); }},
       {"(peak − start) B per M_Ω tet",
        [](const Row& r) { return (r.r.D("peak_kib") - r.r.D("base_kib")) * 1024.0 / r.r.D("omega_tets"); }},
