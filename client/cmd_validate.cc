@@ -1,5 +1,6 @@
 // `svrc validate IN`: reads a PLC, validates it, prints its summary (counts,
 // creases, spread) and every problem found. Exit 0 valid, 3 invalid, 2 usage.
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -68,6 +69,9 @@ int RunValidate(const std::vector<std::string>& args) {
                 isolated, fc->segments.size(), fc->facets.size());
     std::printf("creases    %zu segments, %zu vertices (angle < 90 deg)\n", fc->NumCreaseSegments(),
                 fc->NumCreasePoints());
+    std::string where;
+    const double sharpest = fc->SharpestAngleDeg(&where);
+    if (std::isfinite(sharpest)) std::printf("sharpest   %.6g deg at %s\n", sharpest, where.c_str());
     std::printf("spread     %.6g (diameter %.6g / min distance between disjoint features %.6g)\n",
                 fc->spread, fc->diameter, fc->min_feature_distance);
     if (!fc->closest_features.empty()) std::printf("closest    %s\n", fc->closest_features.c_str());

@@ -124,7 +124,8 @@ std::string FirstCrease(const plc::FeatureComplex& complex, double* sharpest) {
       const geom::Vec3& p = complex.points[i].p;
       *sharpest = 0;
       return absl::StrCat("crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,
-                          "): segments or facets meet there below 90 degrees");
+                          "): segments or facets meet there at ", complex.points[i].min_angle * 180 / M_PI,
+                          " degrees < 90");
     }
   }
   if (worst != nullptr) {

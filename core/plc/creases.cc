@@ -153,6 +153,7 @@ void ComputeCreases(FeatureComplex* fc, double crease_angle_deg) {
         if (!share) m = std::min(m, WedgeWedge(ws[i].second, ws[j].second));
       }
     }
+    fc->points[p].min_angle = m;
     if (m < threshold) fc->points[p].crease = true;
   }
 

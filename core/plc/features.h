@@ -32,6 +32,11 @@ struct FeaturePoint {
   int32_t marker = 0;       // input vertex marker of the first occurrence (0 if none)
   bool crease = false;      // a crease (Def. 5), or an endpoint of a crease segment
   bool isolated = false;    // on no segment and no facet (a lone input vertex)
+  // Smallest angle (radians) between two features meeting at the point that
+  // share no segment there (segment–segment, segment–facet, facet–facet; the
+  // point test of Def. 5); +inf if there are no two. A crease segment's
+  // dihedral is FeatureSegment::min_angle, not counted here.
+  double min_angle = std::numeric_limits<double>::infinity();
   // Facets whose interior contains this point (it is on no segment of the facet):
   // isolated interior points of a facet (TetGen inserts them; so do we).
   std::vector<FacetId> interior_of;
@@ -109,6 +114,10 @@ struct FeatureComplex {
   std::string closest_features;
 
   size_t NumCreasePoints() const;
+  // The sharpest angle of the complex in degrees (the smallest point or
+  // segment min_angle; +inf if none) and where: "point 3 (x, y, z)" or
+  // "segment (a, b)" (points numbered from 0), for `svrc validate`.
+  double SharpestAngleDeg(std::string* where) const;
   size_t NumCreaseSegments() const;
   // Segment id of the piece between a and b (either order), or kNoId.
   SegmentId FindSegment(PointId a, PointId b) const;

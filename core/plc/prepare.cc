@@ -7,11 +7,14 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <set>
+#include <string>
 #include <utility>
 
+#include "absl/strings/str_cat.h"
 #include "core/plc/exact.h"
 #include "core/plc/features_internal.h"
 #include "core/plc/grid.h"
@@ -46,6 +49,27 @@ size_t FeatureComplex::NumCreasePoints() const {
   size_t n = 0;
   for (const FeaturePoint& p : points) n += p.crease;
   return n;
+}
+
+double FeatureComplex::SharpestAngleDeg(std::string* where) const {
+  // Segments first: on a tie the dihedral names the feature better than the
+  // angle its end point sees.
+  double best = std::numeric_limits<double>::infinity();
+  where->clear();
+  for (const FeatureSegment& s : segments) {
+    if (s.min_angle < best) {
+      best = s.min_angle;
+      *where = absl::StrCat("segment (", s.a, ", ", s.b, ")");
+    }
+  }
+  for (PointId i = 0; i < points.size(); ++i) {
+    if (points[i].min_angle < best) {
+      best = points[i].min_angle;
+      const Vec3& x = points[i].p;
+      *where = absl::StrCat("point ", i, " (", x.x, ", ", x.y, ", ", x.z, ")");
+    }
+  }
+  return best * 180 / M_PI;
 }
 
 size_t FeatureComplex::NumCreaseSegments() const {

@@ -44,6 +44,7 @@ TEST(CmdValidate, ExitCodesAndSummary) {
   EXPECT_THAT(out, HasSubstr("vertices   6\n"));
   EXPECT_THAT(out, HasSubstr("facets     5 (5 polygons"));
   EXPECT_THAT(out, HasSubstr("creases    2 segments, 4 vertices"));
+  EXPECT_THAT(out, HasSubstr("sharpest   0.99"));  // the 1° wedge, seen from its apex (session 51)
   EXPECT_THAT(out, HasSubstr("spread     81.05"));
   EXPECT_THAT(out, HasSubstr("VALID\n"));
 

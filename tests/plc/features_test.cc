@@ -266,6 +266,34 @@ TEST(Features, SpreadNamesTheClosestFeatures) {
   EXPECT_FALSE(cube.closest_features.empty());
 }
 
+// A point crease off every crease segment: two edges of two coplanar facets
+// meeting at 0.5°. Session 51: random_plcs.py hull+rot 65 has 0.42° at its
+// point 4, and `svrc validate` said only "8 vertices (angle < 90 deg)". The
+// point keeps its angle and the complex names its sharpest feature.
+TEST(Features, PointCreaseKeepsItsAngle) {
+  // The unit cube with its bottom face cut into a sliver triangle (0, 1, 8)
+  // and the rest, vertex 8 = (1, tan 0.5°, 0) on the edge from 1 to 2.
+  Plc plc = UnitCubePlc();
+  plc.vertices.push_back({1, std::tan(0.5 * kDeg), 0});
+  plc.facets[0] = Tri(0, 1, 8);
+  plc.facets.push_back(Quad(0, 8, 2, 3));
+  const FeatureComplex fc = MustBuild(plc);
+  EXPECT_EQ(fc.NumCreaseSegments(), 0u);
+  EXPECT_TRUE(fc.points[0].crease);
+  EXPECT_NEAR(fc.points[0].min_angle, 0.5 * kDeg, 1e-12);
+  std::string where;
+  EXPECT_NEAR(fc.SharpestAngleDeg(&where), 0.5, 1e-9);
+  EXPECT_EQ(where, "point 0 (0, 0, 0)");
+
+  const FeatureComplex cube = MustBuild(UnitCubePlc());  // every angle 90°: no crease, the sharpest is 90°
+  for (const FeaturePoint& q : cube.points) EXPECT_NEAR(q.min_angle, 90 * kDeg, 1e-9);
+  EXPECT_NEAR(cube.SharpestAngleDeg(&where), 90, 1e-6);
+  EXPECT_FALSE(where.empty());
+  const FeatureComplex wedge = MustBuild(Wedge(30));  // the ridge's dihedral (its end points see 30° too)
+  EXPECT_NEAR(wedge.SharpestAngleDeg(&where), 30, 1e-6);
+  EXPECT_FALSE(where.empty());
+}
+
 TEST(Features, ExampleHoleAndRegions) {
   const FeatureComplex ex = MustBuildFile("b_internal/example.poly");
   // Facet 3 has a hole loop (the inner box's face fills it with facet 20).
