@@ -6,7 +6,7 @@
 # For each seed FROM..TO: bench/svrc/random_plcs.py writes a PLC of KIND,
 # `svrc validate` skips the invalid ones, and svrc_plc_check meshes it and
 # checks every output property (600 s limit). One line per seed:
-#   KIND SEED creases=<crease segments> spread=<Δ> t=<seconds> <check's line>
+#   KIND SEED creases=<crease segments> sharpest=<degrees> spread=<Δ> t=<seconds> <check's line>
 # BUILD is a build directory configured with -DSVRC_BUILD_BENCH=ON. The PLCs
 # are left in $SWEEP_DIR (default: a new temporary directory, printed first).
 set -u
@@ -30,9 +30,10 @@ for seed in $(seq "$from" "$to"); do
   fi
   creases=$(awk '/^creases/ {print $2}' <<<"$v")
   spread=$(awk '/^spread/ {print $2}' <<<"$v")
+  sharpest=$(awk '/^sharpest/ {print $2}' <<<"$v")
   t0=$(date +%s.%N)
   r=$(timeout 600 "$build/bench/svrc/svrc_plc_check" "$f" "$@" 2>&1 | tail -1)
   t1=$(date +%s.%N)
-  printf '%s %s creases=%s spread=%s t=%.1f %s\n' "$kind" "$seed" "$creases" "$spread" \
+  printf '%s %s creases=%s sharpest=%s spread=%s t=%.1f %s\n' "$kind" "$seed" "$creases" "${sharpest:--}" "$spread" \
     "$(echo "$t1 - $t0" | bc)" "${r:-TIMEOUT}"
 done
