@@ -17,7 +17,7 @@
 # output tet and per output vertex.
 set -eu
 if [ $# -lt 1 ]; then
-  sed -n 2,16p "$0"
+  sed -n 2,17p "$0"
   exit 2
 fi
 build=$(cd "$1" && pwd)
