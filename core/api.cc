@@ -111,32 +111,28 @@ constexpr const char* kRefineCollarsPhase = "refine-collars";
 // point off every crease segment: segments meeting at an acute angle).
 std::string FirstCrease(const plc::FeatureComplex& complex, double* sharpest) {
   *sharpest = 90;
-  std::string first;
-  const plc::FeatureSegment* worst = nullptr;
+  plc::SegmentId worst = plc::kNoId;
   std::vector<uint8_t> on_crease_segment(complex.points.size(), 0);
-  for (const plc::FeatureSegment& fs : complex.segments) {
+  for (plc::SegmentId s = 0; s < complex.segments.size(); ++s) {
+    const plc::FeatureSegment& fs = complex.segments[s];
     if (!fs.crease) continue;
     on_crease_segment[fs.a] = on_crease_segment[fs.b] = 1;
-    if (worst == nullptr || fs.min_angle < worst->min_angle) worst = &fs;
+    if (worst == plc::kNoId || fs.min_angle < complex.segments[worst].min_angle) worst = s;
   }
   for (uint32_t i = 0; i < complex.points.size(); ++i) {
     if (complex.points[i].crease && !on_crease_segment[i]) {
-      const geom::Vec3& p = complex.points[i].p;
       *sharpest = 0;
-      return absl::StrCat("crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,
-                          "): segments or facets meet there at ", complex.points[i].min_angle * 180 / M_PI,
-                          " degrees < 90");
+      return absl::StrCat("crease at ", complex.PointName(i), ": segments or facets meet there at ",
+                          complex.points[i].min_angle * 180 / M_PI, " degrees < 90");
     }
   }
-  if (worst != nullptr) {
-    *sharpest = worst->min_angle * 180 / M_PI;
-    return absl::StrCat("crease at segment (", worst->a, ", ", worst->b, "): features meet at ", *sharpest,
-                        " degrees < 90");
+  if (worst != plc::kNoId) {
+    *sharpest = complex.segments[worst].min_angle * 180 / M_PI;
+    return absl::StrCat("crease at ", complex.SegmentName(worst), ": features meet at ", *sharpest, " degrees < 90");
   }
   for (uint32_t i = 0; i < complex.points.size(); ++i) {
     if (complex.points[i].crease) {
-      const geom::Vec3& p = complex.points[i].p;
-      return absl::StrCat("crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z, "): features meet below 90 degrees");
+      return absl::StrCat("crease at ", complex.PointName(i), ": features meet below 90 degrees");
     }
   }
   return {};

@@ -308,11 +308,8 @@ void ComputeSpread(FeatureComplex* fc) {
     fc->min_feature_distance = d;
     fc->spread = fc->diameter / d;
     auto name = [&](Feature f) -> std::string {
-      if (f.kind == 0) {
-        const Vec3& x = P(f.id);
-        return absl::StrCat("point ", f.id, " (", x.x, ", ", x.y, ", ", x.z, ")");
-      }
-      if (f.kind == 1) return absl::StrCat("segment (", fc->segments[f.id].a, ", ", fc->segments[f.id].b, ")");
+      if (f.kind == 0) return fc->PointName(f.id);
+      if (f.kind == 1) return fc->SegmentName(f.id);
       const uint32_t input = fc->facets[f.id].input_facet;
       return absl::StrCat("facet ", input != kNoId ? input : f.id);
     };

@@ -114,9 +114,13 @@ struct FeatureComplex {
   std::string closest_features;
 
   size_t NumCreasePoints() const;
+  // How messages name features: "point 3 (x, y, z)", "segment (a, b)"
+  // (points numbered from 0, a segment by its end points).
+  std::string PointName(PointId p) const;
+  std::string SegmentName(SegmentId s) const;
   // The sharpest angle of the complex in degrees (the smallest point or
-  // segment min_angle; +inf if none) and where: "point 3 (x, y, z)" or
-  // "segment (a, b)" (points numbered from 0), for `svrc validate`.
+  // segment min_angle; +inf if none) and where, as PointName / SegmentName
+  // give it (empty if none), for `svrc validate`.
   double SharpestAngleDeg(std::string* where) const;
   size_t NumCreaseSegments() const;
   // Segment id of the piece between a and b (either order), or kNoId.

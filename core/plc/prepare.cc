@@ -51,24 +51,34 @@ size_t FeatureComplex::NumCreasePoints() const {
   return n;
 }
 
+std::string FeatureComplex::PointName(PointId p) const {
+  const Vec3& x = points[p].p;
+  return absl::StrCat("point ", p, " (", x.x, ", ", x.y, ", ", x.z, ")");
+}
+
+std::string FeatureComplex::SegmentName(SegmentId s) const {
+  return absl::StrCat("segment (", segments[s].a, ", ", segments[s].b, ")");
+}
+
 double FeatureComplex::SharpestAngleDeg(std::string* where) const {
   // Segments first: on a tie the dihedral names the feature better than the
   // angle its end point sees.
   double best = std::numeric_limits<double>::infinity();
-  where->clear();
-  for (const FeatureSegment& s : segments) {
-    if (s.min_angle < best) {
-      best = s.min_angle;
-      *where = absl::StrCat("segment (", s.a, ", ", s.b, ")");
+  SegmentId seg = kNoId;
+  PointId point = kNoId;
+  for (SegmentId s = 0; s < segments.size(); ++s) {
+    if (segments[s].min_angle < best) {
+      best = segments[s].min_angle;
+      seg = s;
     }
   }
   for (PointId i = 0; i < points.size(); ++i) {
     if (points[i].min_angle < best) {
       best = points[i].min_angle;
-      const Vec3& x = points[i].p;
-      *where = absl::StrCat("point ", i, " (", x.x, ", ", x.y, ", ", x.z, ")");
+      point = i;
     }
   }
+  *where = point != kNoId ? PointName(point) : seg != kNoId ? SegmentName(seg) : std::string();
   return best * 180 / M_PI;
 }
 

@@ -4720,16 +4720,15 @@ absl::StatusOr<PointSetRefinement> RefinePlcImpl(const plc::FeatureComplex& comp
   for (uint32_t s = 0; s < complex.segments.size() && !creases_ok; ++s) {
     const plc::FeatureSegment& fs = complex.segments[s];
     if (fs.crease) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "SVRC: crease at segment (", fs.a, ", ", fs.b, "): features meet at ", fs.min_angle * 180 / M_PI,
-          " degrees < 90; creases need collars, not implemented yet"));
+      return absl::FailedPreconditionError(absl::StrCat("SVRC: crease at ", complex.SegmentName(s),
+                                                        ": features meet at ", fs.min_angle * 180 / M_PI,
+                                                        " degrees < 90; creases need collars, not implemented yet"));
     }
   }
   for (uint32_t i = 0; i < complex.points.size() && !creases_ok; ++i) {
     if (complex.points[i].crease) {
-      const Vec3& p = complex.points[i].p;
-      return absl::FailedPreconditionError(absl::StrCat("SVRC: crease at point ", i, " (", p.x, ", ", p.y, ", ", p.z,
-                                                        "): features meet below 90 degrees; creases need collars, "
+      return absl::FailedPreconditionError(absl::StrCat("SVRC: crease at ", complex.PointName(i),
+                                                        ": features meet below 90 degrees; creases need collars, "
                                                         "not implemented yet"));
     }
   }
