@@ -9,14 +9,20 @@
 //
 //   LD_PRELOAD=build/release/bench/svrc/libsvrc_heap_peak.so tetgen -pq2a1e-5 -Q cube.poly
 //
+// svrc_sensitivity_bench links the library instead and reads the counters in
+// process (svrc_heap_now, svrc_heap_peak, svrc_heap_reset_peak); the report
+// at exit is then left out unless SVRC_HEAP_PEAK_OUT is set.
+//
 // Single counters with relaxed atomics: the processes measured here allocate
 // from one thread at a time or sum the same either way.
 #define _GNU_SOURCE
+#include <errno.h>
 #include <malloc.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
 extern void* __libc_malloc(size_t);
@@ -67,7 +73,7 @@ void* aligned_alloc(size_t align, size_t n) { return memalign(align, n); }
 
 int posix_memalign(void** out, size_t align, size_t n) {
   void* p = __libc_memalign(align, n);
-  if (p == NULL) return 12;  // ENOMEM
+  if (p == NULL) return ENOMEM;
   count(usable(p));
   *out = p;
   return 0;
@@ -79,14 +85,23 @@ void free(void* p) {
   __libc_free(p);
 }
 
+long long svrc_heap_now(void) { return (long long)atomic_load_explicit(&g_now, memory_order_relaxed); }
+
+long long svrc_heap_peak(void) { return (long long)atomic_load_explicit(&g_peak, memory_order_relaxed); }
+
+void svrc_heap_reset_peak(void) {
+  atomic_store_explicit(&g_peak, atomic_load_explicit(&g_now, memory_order_relaxed), memory_order_relaxed);
+}
+
 __attribute__((destructor)) static void report(void) {
-  const long long peak = (long long)atomic_load_explicit(&g_peak, memory_order_relaxed);
+  const long long peak = svrc_heap_peak();
   const char* path = getenv("SVRC_HEAP_PEAK_OUT");
+  const char* preload = getenv("LD_PRELOAD");
   FILE* f = path != NULL ? fopen(path, "a") : NULL;
   if (f != NULL) {
     fprintf(f, "heap_peak=%lld\n", peak);
     fclose(f);
-  } else {
+  } else if (preload != NULL && strstr(preload, "svrc_heap_peak") != NULL) {
     char line[64];
     const int len = snprintf(line, sizeof line, "heap_peak=%lld\n", peak);
     if (len > 0) (void)!write(2, line, (size_t)len);

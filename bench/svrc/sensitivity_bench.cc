@@ -26,7 +26,6 @@
 // Internal: --one cube V | skew n V | spread k | file PATH  (one run, prints
 // one "RESULT key=value ..." line).
 #include <fcntl.h>
-#include <malloc.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/time.h>
@@ -35,7 +34,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -45,7 +43,6 @@
 #include <cstring>
 #include <fstream>
 #include <map>
-#include <new>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -62,69 +59,23 @@
 #include "core/svrc/assemble.h"
 #include "core/svrc/refiner.h"
 
-// Heap accounting of this process: malloc, calloc, realloc, the aligned
-// allocators and free are interposed here (glibc's __libc_* entry points do
-// the work), so every byte the run allocates is counted — operator new and
-// aligned new go through them, and so does util::PodVector's realloc — as
-// malloc_usable_size, with the high-water mark. "peak heap" is that mark
-// during one run minus the bytes live at its start: the data structures' own
-// bytes, without the code pages, libraries and allocator slack that RSS also
-// holds (a run of 10^4 tets peaks at ~14 MB RSS above its start, so a few MB
-// of those shift its ratio). A realloc counts its growth only: glibc grows
-// large blocks with mremap, without a second copy (sessions before 17
-// counted operator new alone, and aligned new not at all).
+// Heap accounting of this process: the bench links libsvrc_heap_peak.so
+// (bench/svrc/heap_peak.c), whose malloc, calloc, realloc, aligned allocators
+// and free take the place of glibc's, so every byte the run allocates is
+// counted — operator new and aligned new go through them, and so does
+// util::PodVector's realloc — as malloc_usable_size, with the high-water mark.
+// "peak heap" is that mark during one run minus the bytes live at its start:
+// the data structures' own bytes, without the code pages, libraries and
+// allocator slack that RSS also holds (a run of 10^4 tets peaks at ~14 MB RSS
+// above its start, so a few MB of those shift its ratio). A realloc counts
+// its growth only: glibc grows large blocks with mremap, without a second
+// copy (sessions before 17 counted operator new alone, and aligned new not at
+// all). Preloaded, the same library measures tetgen and the CLI on this scale
+// (bench/svrc/flatness_vs_tetgen.sh).
 extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void* __libc_memalign(size_t, size_t);
-void __libc_free(void*);
-}
-namespace {
-std::atomic<int64_t> g_heap_now{0};
-std::atomic<int64_t> g_heap_peak{0};
-void CountDelta(int64_t delta) {
-  const int64_t now = g_heap_now.fetch_add(delta, std::memory_order_relaxed) + delta;
-  int64_t peak = g_heap_peak.load(std::memory_order_relaxed);
-  while (now > peak && !g_heap_peak.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
-  }
-}
-int64_t Usable(void* p) { return p == nullptr ? 0 : static_cast<int64_t>(malloc_usable_size(p)); }
-}  // namespace
-
-extern "C" {
-void* malloc(size_t n) {
-  void* p = __libc_malloc(n);
-  CountDelta(Usable(p));
-  return p;
-}
-void* calloc(size_t n, size_t size) {
-  void* p = __libc_calloc(n, size);
-  CountDelta(Usable(p));
-  return p;
-}
-void* realloc(void* old, size_t n) {
-  const int64_t before = Usable(old);
-  void* p = __libc_realloc(old, n);
-  if (p != nullptr || n == 0) CountDelta(Usable(p) - before);
-  return p;
-}
-void* memalign(size_t align, size_t n) {
-  void* p = __libc_memalign(align, n);
-  CountDelta(Usable(p));
-  return p;
-}
-void* aligned_alloc(size_t align, size_t n) { return memalign(align, n); }
-int posix_memalign(void** out, size_t align, size_t n) {
-  void* p = memalign(align, n);
-  if (p == nullptr) return ENOMEM;
-  *out = p;
-  return 0;
-}
-void free(void* p) {
-  CountDelta(-Usable(p));
-  __libc_free(p);
-}
+long long svrc_heap_now(void);
+long long svrc_heap_peak(void);
+void svrc_heap_reset_peak(void);
 }
 
 namespace svrc::bench {
@@ -170,8 +121,8 @@ bool SameMesh(const mesh::TetMesh& a, const mesh::TetMesh& b) {
 // status=... message=..." on failure) to stdout.
 int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify) {
   const long base_kib = RssKib();
-  const int64_t heap_base = g_heap_now.load();
-  g_heap_peak.store(heap_base);
+  const int64_t heap_base = svrc_heap_now();
+  svrc_heap_reset_peak();
   plc::Plc plc;
   double max_volume = 0;
   const std::string kind = args.empty() ? "" : args[0];
@@ -233,7 +184,7 @@ int RunOne(const std::vector<std::string>& args, double radius_edge, bool verify
   }
   const double w3 = WallNow(), c3 = CpuNow();
   const long peak_kib = PeakRssKib();  // before the measurements below allocate
-  const int64_t heap_peak = g_heap_peak.load() - heap_base;
+  const int64_t heap_peak = svrc_heap_peak() - heap_base;
 
   const refine::RefineStats& s = refined->stats;
   const mesh::TetMesh& m = out->mesh;
@@ -518,7 +469,7 @@ void PrintFlatness(const std::string& series, const std::vector<Row>& rows) {
   // per-run cost cancels out).
   const Measure omega[] = {
       {"cpu µs per output vertex", [](const Row& r) { return 1e6 * r.cpu / r.r.D("out_vertices"); }},
-      {"peak heap B per output vertex", [](const Row& r) { return r.heap_b * r.tets / r.r.D("out_vertices"); }},
+      {"peak heap B per output vertex", [](const Row& r) { return r.r.D("heap_peak") / r.r.D("out_vertices"); }},
       {"cpu µs per M_Ω tet", [](const Row& r) { return 1e6 * r.cpu / r.r.D("omega_tets"); }},
       {"(peak − start) B per M_Ω tet",
        [](const Row& r) { return (r.r.D("peak_kib") - r.r.D("base_kib")) * 1024.0 / r.r.D("omega_tets"); }},
